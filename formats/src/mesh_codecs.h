@@ -1,0 +1,31 @@
+// Internal entry points of the per-format readers and writers. read_mesh() picks one by
+// extension; read_sphere_map() parses bytes it has already read (to also see the header).
+// Readers get the whole file in memory and the path only for messages.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "spherekit/formats/mesh_io.h"
+
+namespace spherekit::formats::detail {
+
+Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
+Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
+Result<TriMesh> read_off(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
+Result<TriMesh> read_stl(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
+/// `glb`: binary container (.glb) rather than JSON text (.gltf). External buffers are
+/// resolved relative to the folder of `path`.
+Result<TriMesh> read_gltf(const std::string& path, std::string_view bytes, bool glb, const ReadOptions& options,
+                          ReadInfo& info);
+
+/// Parses a mesh file already in memory, choosing the reader by the extension of `path`.
+Result<TriMesh> parse_mesh(const std::string& path, std::string_view bytes, const ReadOptions& options,
+                           ReadInfo* info);
+
+/// OBJ text: `header` (already '#'-commented lines) first, then `v` lines and 1-based `f` lines.
+std::string format_obj(const TriMesh& mesh, int precision, const std::string& header);
+/// PLY: binary little endian with double coordinates and int indices, or ascii.
+std::string format_ply(const TriMesh& mesh, bool binary, int precision);
+
+}  // namespace spherekit::formats::detail

@@ -1,0 +1,61 @@
+// Progressive mesh by half-edge collapses (Hoppe 1996), vertices keep their original
+// positions, ordered by an n-D quadric error (Garland & Heckbert 1998), down to a
+// tetrahedron. The same simplifier serves the unconstrained map (d = 3) and the consistent
+// method's step 5 (d = 3n, Asirvatham et al. 2005 §3).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "spherekit/mesh.h"
+#include "spherekit/progress.h"
+#include "spherekit/status.h"
+
+namespace spherekit {
+
+/// One half-edge collapse vt -> vs, recorded so that the vertex split can replay it exactly.
+struct HalfEdgeCollapse {
+  int vt = -1;                   ///< the vertex removed (re-inserted by the split)
+  int vs = -1;                   ///< the vertex it collapses into (keeps its position)
+  int vl = -1, vr = -1;          ///< third vertices of the two faces removed: (vs,vt,vl)...
+  std::array<int, 2> removed{{-1, -1}};  ///< face ids removed by the collapse
+  int moved_begin = 0, moved_end = 0;    ///< range in ProgressiveMesh::moved_faces
+};
+
+/// A progressive mesh: the full mesh, the sequence of collapses (simplification order) and
+/// enough bookkeeping to replay it backwards as vertex splits.
+struct ProgressiveMesh {
+  int num_vertices = 0;
+  RowMat3i F;                              ///< full-resolution faces (input order)
+  std::vector<HalfEdgeCollapse> collapses; ///< in simplification order
+  std::vector<int> moved_faces;            ///< faces whose vt became vs, per collapse range
+  /// Face corners at the moment each face was removed (flattened 3 per removed face, in
+  /// collapse order, two faces per collapse): the split restores them exactly.
+  std::vector<std::array<int, 3>> removed_corners;
+  std::vector<int> base_vertices;          ///< vertices alive at the base (4 for a tetrahedron)
+  std::vector<int> base_faces;             ///< faces alive at the base
+  int forced_collapses = 0;                ///< collapses that had to ignore the geometric checks
+};
+
+struct ProgressiveMeshOptions {
+  /// Weight of each face's quadric (e.g. small for faces that close holes); empty = 1.
+  std::vector<double> face_weights;
+  /// Vertices that must never be removed (feature vertices); empty = none.
+  std::vector<char> keep_vertices;
+  /// Stop when this many vertices remain (4 = tetrahedron; larger for constrained bases).
+  int target_vertices = 4;
+  /// Relative weight of the squared edge length added to the quadric cost; it breaks the
+  /// ties QEM leaves in flat regions in favour of short edges (better-shaped levels).
+  double edge_length_weight = 0.05;
+};
+
+/// Builds the progressive mesh of a closed, manifold, genus-0 triangle mesh whose vertex
+/// coordinates P are #V by d (d = 3 for one model, 3n for n models; each consecutive block
+/// of 3 columns is one model, used for fold-over checks).
+/// Errors: InvalidInput (sizes), SolverFailed (could not reach the target, e.g. not genus 0),
+/// Cancelled.
+Result<ProgressiveMesh> build_progressive_mesh(const RowMatXd& P, const RowMat3i& F,
+                                               const ProgressiveMeshOptions& options = {},
+                                               const ProgressFn& progress = {});
+
+}  // namespace spherekit

@@ -1,0 +1,53 @@
+// Unconstrained spherical parameterization (Praun & Hoppe 2003): progressive mesh down
+// to a tetrahedron, regular tetrahedron on the sphere, coarse-to-fine vertex splits with
+// kernel-constrained L2-stretch minimization. Bijective by construction and by check.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "spherekit/mesh.h"
+#include "spherekit/progress.h"
+#include "spherekit/sphere_map.h"
+#include "spherekit/status.h"
+
+namespace spherekit {
+
+struct SphereParamOptions {
+  // Shape-defining: changing these changes the answer (recorded in Provenance).
+  double regularizer_weight = 1e-4;  ///< weight of the anti-sliver term w * min(a',c')^-3 (Praun & Hoppe 2003)
+  double hole_weight = 1e-5;         ///< energy weight of faces added to close holes
+  std::uint64_t seed = 1;            ///< every random choice (line-search directions) derives from this
+  bool align_rotation = true;        ///< rotate the result so face directions best match surface normals
+  // Effort: changes only speed and accuracy.
+  int effort = 2;                    ///< 0..5; expands to the presets in sphere_param.cpp
+  int threads = 0;                   ///< worker threads for the optimization passes; 0 = hardware
+};
+
+/// Wall-clock seconds spent in each part.
+struct SphereParamTimes {
+  double check = 0, simplify = 0, refine = 0, total = 0;
+};
+
+struct SphereParamResult {
+  SphereMap map;                 ///< one unit vector per input vertex (holes' centre vertices removed)
+  int flipped_faces = 0;         ///< faces with det <= 0 by the exact predicate: 0 for a bijection
+  double efficiency = 0;         ///< stretch efficiency over the input's faces (metrics.h definition)
+  double l2_stretch = 0, linf_stretch = 0;
+  double winding = 0;            ///< closed inputs: signed area / 4 pi (+1)
+  int holes_filled = 0;
+  int base_vertices = 0;         ///< vertices of the progressive mesh base (4: tetrahedron)
+  int optimization_passes = 0;   ///< global passes run
+  SphereParamTimes times;
+};
+
+/// Maps a genus-0 triangle mesh (boundary loops allowed; they are filled with low-weight
+/// faces) bijectively onto the unit sphere, minimizing the L2 stretch of sphere -> surface.
+/// @param[in] mesh  genus-0, one component, manifold, finite (see check_mesh / require_genus0)
+/// @return the map and its measures, or InvalidInput (not genus 0 ...), Cancelled, SolverFailed.
+/// Deterministic: same input and options give the same bits, for any thread count.
+/// Cost: about O(V log V) simplification plus a constant number of passes per level.
+Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereParamOptions& options = {},
+                                              const ProgressFn& progress = {});
+
+}  // namespace spherekit

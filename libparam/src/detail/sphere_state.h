@@ -1,0 +1,92 @@
+// The mutable state of a coarse-to-fine spherical embedding: the current level of a
+// progressive mesh with a position on the unit sphere for every alive vertex.
+// Internal to libparam.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "spherekit/mesh.h"
+
+namespace spherekit::detail {
+
+struct SphereState {
+  const RowMatXd* P = nullptr;  ///< #V by 3m surface positions (m models; m = 1 normally)
+  int models = 1;
+  std::vector<std::array<int, 3>> F;  ///< current corners of every face (ids stable)
+  std::vector<char> face_alive;
+  std::vector<double> face_weight;    ///< energy weight per face (hole faces: small)
+  std::vector<std::vector<int>> vf;   ///< alive faces around each vertex
+  RowMat3d S;                         ///< sphere position of every vertex (alive ones valid)
+  std::vector<char> vertex_alive;
+  std::vector<char> fixed;            ///< vertices the optimizer must not move (features)
+  int alive_vertices = 0;
+  std::vector<double> model_area;     ///< total surface area per model at the current level
+  std::vector<double> area_floor;     ///< per model: minimum energy weight area of a face
+
+  /// Recomputes model_area over the alive faces.
+  void update_areas();
+};
+
+/// Per-effort settings of the optimizer (Praun & Hoppe 2003's schedule; the numbers are
+/// the reference implementation's presets, REFERENCE.md §2.5).
+struct OptimizerSettings {
+  int line_search_iter = 10;   ///< energy evaluations per 1-D search
+  int vsplit_vt_iter = 2;      ///< local optimizations of each inserted vertex
+  int vsplit_nei_iter = 0;     ///< local optimizations of its neighbours
+  int global_iter = 3;         ///< passes (rounds until no vertex is active) per level
+  double movetol = 1e-3;       ///< a vertex stays active while its credit exceeds this
+  double nv_ratio = 1.2;       ///< a level is optimized each time #V grows by this factor
+  double regularizer_weight = 1e-4;
+  /// Faces whose chord plane passes closer than this to the centre (large spherical
+  /// triangles) are evaluated with Praun & Hoppe's accordion split; the final full-resolution
+  /// pass sets 0 and optimizes exactly the measured chord-triangle stretch.
+  double split_distance = 0.9;
+  std::uint64_t seed = 1;
+  int threads = 0;             ///< 0 = hardware concurrency
+  int max_rounds = 2000;       ///< safety cap on rounds per pass
+};
+
+OptimizerSettings settings_for_effort(int effort);
+
+/// Scratch memory for one vertex's 1-ring (one per thread).
+struct RingScratch {
+  struct Face {
+    Eigen::Vector3d qa, qb;  ///< sphere points of the other two corners, ccw after v
+    Eigen::Vector3d n;       ///< qa x qb: the kernel constraint n . x > 0
+    int f;                   ///< face id
+    int a, b;                ///< other corner vertex ids
+  };
+  std::vector<Face> faces;
+  std::vector<double> surf;  ///< per face and model: d1 (3), d2 (3), area weight (1)
+};
+
+/// Loads v's ring into scratch. Returns false if v has no faces.
+bool load_ring(const SphereState& st, int v, RingScratch& ring);
+
+/// Stretch energy of v's ring with v at sphere point x (+inf if a chord triangle degenerates).
+/// Faces whose chord plane is closer to the centre than `split_distance` are evaluated with
+/// the accordion split; 0 evaluates every face on its chord triangle (the measured energy).
+double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x, double reg_weight,
+                   double split_distance);
+
+/// True if every ring face is positively oriented with v at x, by exact predicate.
+bool ring_valid_exact(const RingScratch& ring, const Eigen::Vector3d& x);
+
+/// Up to `searches` kernel-constrained line searches (random great-circle direction, then
+/// the perpendicular) from v's current position; `key` seeds the direction. Writes the
+/// improved position to *out and returns true if the energy decreased (validity checked
+/// exactly). Reads st only: safe to call concurrently for different vertices.
+bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const OptimizerSettings& s,
+                     RingScratch& ring, Eigen::Vector3d* out, int searches = 2);
+
+/// A global pass (Praun & Hoppe 2003 / REFERENCE.md §2.5): rounds in which all active
+/// vertices compute a move in parallel from the current positions, then moves are applied
+/// greedily as an independent set (largest first). Deterministic for any thread count.
+/// Returns the number of rounds, or -1 if cancelled by `keep_going`.
+int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
+                 const std::function<bool()>& keep_going);
+
+}  // namespace spherekit::detail

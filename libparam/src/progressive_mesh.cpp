@@ -1,0 +1,305 @@
+// Progressive mesh by half-edge collapses at original positions.
+//   Hoppe 1996, "Progressive meshes" (vertex split / edge collapse records);
+//   Garland & Heckbert 1997/1998 (quadric error, n-D form, see detail/quadric.h);
+//   Praun & Hoppe 2003 §4 (half-edge collapses to a tetrahedron as the base of the
+//   coarse-to-fine spherical parameterization).
+//
+// Design: faces keep their ids for the whole run (dead faces are flagged), so a collapse is
+// recorded as "these faces had vt replaced by vs" plus "these two faces were removed with
+// these corners"; replaying the records backwards restores every intermediate mesh exactly.
+// Costs live in a binary heap with lazy invalidation by per-vertex stamps: a vertex's stamp
+// changes when its quadric does (it received a collapse), which is the only time the cost
+// of its edges changes. Legality (link condition, fold-over) depends on the neighbourhood
+// and is re-checked when an entry is popped; edges rejected then are retried by a full
+// rebuild of the heap when it runs dry.
+//
+// Cost: O(F log F) time, O(V d^2) memory for the quadrics.
+#include "spherekit/progressive_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <queue>
+#include <string>
+
+#include "detail/quadric.h"
+
+namespace spherekit {
+namespace {
+
+struct HeapEntry {
+  double cost;
+  int vt, vs;
+  std::uint32_t stamp_t, stamp_s;
+};
+struct HeapGreater {
+  bool operator()(const HeapEntry& a, const HeapEntry& b) const {
+    if (a.cost != b.cost) return a.cost > b.cost;
+    if (a.vt != b.vt) return a.vt > b.vt;  // ties broken by ids: deterministic
+    return a.vs > b.vs;
+  }
+};
+
+// Below this triangle quality a collapse may not make things worse (a quality-0.02 triangle
+// has angles around 1 degree); the forced last-resort mode ignores it.
+constexpr double kMinQuality = 0.02;
+
+double quality(const Eigen::Vector3d* p, const Eigen::Vector3d& n) {
+  double l2 = (p[1] - p[0]).squaredNorm() + (p[2] - p[1]).squaredNorm() + (p[0] - p[2]).squaredNorm();
+  return l2 > 0 ? 2.0 * std::sqrt(3.0) * n.norm() / l2 : 0.0;
+}
+
+class Simplifier {
+ public:
+  Simplifier(const RowMatXd& P, const RowMat3i& F, const ProgressiveMeshOptions& opt)
+      : P_(P), opt_(opt), d_(static_cast<int>(P.cols())), nv_(static_cast<int>(P.rows())) {
+    const int nf = static_cast<int>(F.rows());
+    faces_.resize(static_cast<size_t>(nf));
+    face_alive_.assign(static_cast<size_t>(nf), 1);
+    vf_.resize(static_cast<size_t>(nv_));
+    for (int f = 0; f < nf; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        faces_[f][k] = F(f, k);
+        vf_[static_cast<size_t>(F(f, k))].push_back(f);
+      }
+    }
+    vertex_alive_.assign(static_cast<size_t>(nv_), 1);
+    stamp_.assign(static_cast<size_t>(nv_), 0);
+    quadric_.assign(static_cast<size_t>(nv_), detail::QuadricND(d_));
+    area_.assign(static_cast<size_t>(nv_), 0.0);
+    for (int f = 0; f < nf; ++f) {
+      double w = opt_.face_weights.empty() ? 1.0 : opt_.face_weights[static_cast<size_t>(f)];
+      double area = face_area(faces_[f]) * w;
+      detail::QuadricND q(d_);
+      q.add_triangle(P_.row(F(f, 0)).data(), P_.row(F(f, 1)).data(), P_.row(F(f, 2)).data(), area);
+      for (int k = 0; k < 3; ++k) {
+        quadric_[static_cast<size_t>(F(f, k))].add(q);
+        area_[static_cast<size_t>(F(f, k))] += area / 3.0;
+      }
+    }
+    alive_count_ = nv_;
+  }
+
+  Status run(ProgressiveMesh& pm, const ProgressFn& progress) {
+    const int target = std::max(4, opt_.target_vertices);
+    const int total = std::max(1, nv_ - target);
+    bool forced = false;
+    int last_report = -1;
+    while (alive_count_ > target) {
+      rebuild_heap();
+      int collapsed_this_round = 0;
+      while (alive_count_ > target && !heap_.empty()) {
+        HeapEntry e = heap_.top();
+        heap_.pop();
+        if (!vertex_alive_[e.vt] || !vertex_alive_[e.vs]) continue;
+        if (e.stamp_t != stamp_[e.vt] || e.stamp_s != stamp_[e.vs]) continue;
+        if (!collapse_if_legal(e.vt, e.vs, forced, pm)) continue;
+        ++collapsed_this_round;
+        int done = nv_ - alive_count_;
+        int pct = static_cast<int>(100.0 * done / total);
+        if (pct != last_report) {
+          last_report = pct;
+          if (!report_progress(progress, "simplify", alive_count_, static_cast<double>(done) / total))
+            return Status(ErrorCode::Cancelled, "cancelled during simplification");
+        }
+      }
+      if (alive_count_ <= target) break;
+      if (collapsed_this_round == 0) {
+        // Nothing legal under the geometric checks: allow fold-overs as a last resort (the
+        // sphere embedding does not depend on the 3D quality of coarse levels), keeping
+        // the topological link condition, which alone guarantees a valid progressive mesh.
+        if (forced)
+          return Status(ErrorCode::SolverFailed,
+                        "simplification stuck at " + std::to_string(alive_count_) +
+                            " vertices (no legal edge collapse; is the mesh genus 0 and manifold?)");
+        forced = true;
+      }
+    }
+    for (int v = 0; v < nv_; ++v)
+      if (vertex_alive_[v]) pm.base_vertices.push_back(v);
+    for (size_t f = 0; f < faces_.size(); ++f)
+      if (face_alive_[f]) pm.base_faces.push_back(static_cast<int>(f));
+    return Status();
+  }
+
+ private:
+  double face_area(const std::array<int, 3>& f) const {
+    // Sum of the 3D areas of each model block (d = 3n): one weight for all models.
+    double a = 0;
+    for (int b = 0; b + 2 < d_; b += 3) {
+      Eigen::Vector3d p0 = P_.row(f[0]).segment<3>(b).transpose();
+      Eigen::Vector3d p1 = P_.row(f[1]).segment<3>(b).transpose();
+      Eigen::Vector3d p2 = P_.row(f[2]).segment<3>(b).transpose();
+      a += 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    }
+    return a;
+  }
+
+  double cost(int vt, int vs) const {
+    const double* ps = P_.row(vs).data();
+    const double* pt = P_.row(vt).data();
+    double q = quadric_[vt].evaluate(ps) + quadric_[vs].evaluate(ps);
+    double len2 = 0;
+    for (int i = 0; i < d_; ++i) len2 += (ps[i] - pt[i]) * (ps[i] - pt[i]);
+    return q + opt_.edge_length_weight * len2 * area_[vt];
+  }
+
+  void push_edge(int a, int b) {
+    bool keep_a = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(a)];
+    bool keep_b = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(b)];
+    if (!keep_a) heap_.push({cost(a, b), a, b, stamp_[a], stamp_[b]});
+    if (!keep_b) heap_.push({cost(b, a), b, a, stamp_[b], stamp_[a]});
+  }
+
+  void rebuild_heap() {
+    heap_ = decltype(heap_)();
+    for (size_t f = 0; f < faces_.size(); ++f) {
+      if (!face_alive_[f]) continue;
+      for (int k = 0; k < 3; ++k) {
+        int a = faces_[f][k], b = faces_[f][(k + 1) % 3];
+        if (a < b) push_edge(a, b);  // each undirected edge once (closed, oriented mesh)
+      }
+    }
+  }
+
+  void neighbours(int v, std::vector<int>& out) const {
+    out.clear();
+    for (int f : vf_[v])
+      for (int k = 0; k < 3; ++k)
+        if (faces_[f][k] != v) out.push_back(faces_[f][k]);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+  bool collapse_if_legal(int vt, int vs, bool forced, ProgressiveMesh& pm) {
+    // The two faces sharing edge (vt, vs) and their third vertices.
+    int shared[2] = {-1, -1}, third[2] = {-1, -1}, ns = 0;
+    for (int f : vf_[vt]) {
+      const auto& c = faces_[f];
+      if (c[0] != vs && c[1] != vs && c[2] != vs) continue;
+      if (ns == 2) return false;  // non-manifold edge
+      shared[ns] = f;
+      for (int k = 0; k < 3; ++k)
+        if (c[k] != vt && c[k] != vs) third[ns] = c[k];
+      ++ns;
+    }
+    if (ns != 2) return false;
+    // Link condition (Dey et al.): the common neighbours of vt and vs must be exactly the two
+    // opposite vertices, else the collapse pinches the surface.
+    neighbours(vt, nt_);
+    neighbours(vs, ns_);
+    int common = 0;
+    for (size_t i = 0, j = 0; i < nt_.size() && j < ns_.size();) {
+      if (nt_[i] < ns_[j]) ++i;
+      else if (nt_[i] > ns_[j]) ++j;
+      else { ++common; ++i; ++j; }
+    }
+    if (common != 2) return false;
+    if (!forced) {
+      // Valence cap: very high valences make tiny spherical kernels at coarse levels.
+      if (nt_.size() + ns_.size() - 4 > 24) return false;
+      // Fold-over check per model: no face around vt may flip its normal when vt moves to vs.
+      // Shape check: no new needle/cap worse than what was there (quality = 4 sqrt3 area /
+      // sum of squared edges, 1 for equilateral). Degenerate coarse triangles give the
+      // sphere embedding nearly empty kernels at the next splits.
+      double q_old = 1.0, q_new = 1.0;
+      for (int f : vf_[vt]) {
+        if (f == shared[0] || f == shared[1]) continue;
+        const auto& c = faces_[f];
+        for (int b = 0; b + 2 < d_; b += 3) {
+          Eigen::Vector3d p[3], q[3];
+          for (int k = 0; k < 3; ++k) {
+            p[k] = P_.row(c[k]).segment<3>(b).transpose();
+            q[k] = c[k] == vt ? Eigen::Vector3d(P_.row(vs).segment<3>(b).transpose()) : p[k];
+          }
+          Eigen::Vector3d n0 = (p[1] - p[0]).cross(p[2] - p[0]);
+          Eigen::Vector3d n1 = (q[1] - q[0]).cross(q[2] - q[0]);
+          // Reject flips and near-degenerate results: cosine of the normal change > 0.
+          if (!(n0.dot(n1) > 0)) return false;
+          q_old = std::min(q_old, quality(p, n0));
+          q_new = std::min(q_new, quality(q, n1));
+        }
+      }
+      if (q_new < kMinQuality && q_new < q_old) return false;
+    }
+    // Commit.
+    HalfEdgeCollapse rec;
+    rec.vt = vt;
+    rec.vs = vs;
+    rec.vl = third[0];
+    rec.vr = third[1];
+    rec.removed = {shared[0], shared[1]};
+    rec.moved_begin = static_cast<int>(pm.moved_faces.size());
+    for (int s = 0; s < 2; ++s) {
+      int f = shared[s];
+      pm.removed_corners.push_back(faces_[f]);
+      face_alive_[f] = 0;
+      for (int k = 0; k < 3; ++k) {
+        int v = faces_[f][k];
+        if (v == vt) continue;
+        auto& list = vf_[v];
+        list.erase(std::find(list.begin(), list.end(), f));
+      }
+    }
+    for (int f : vf_[vt]) {
+      if (f == shared[0] || f == shared[1]) continue;
+      for (int k = 0; k < 3; ++k)
+        if (faces_[f][k] == vt) faces_[f][k] = vs;
+      vf_[vs].push_back(f);
+      pm.moved_faces.push_back(f);
+    }
+    rec.moved_end = static_cast<int>(pm.moved_faces.size());
+    vf_[vt].clear();
+    vertex_alive_[vt] = 0;
+    --alive_count_;
+    quadric_[vs].add(quadric_[vt]);
+    area_[vs] += area_[vt];
+    ++stamp_[vs];
+    if (forced) ++pm.forced_collapses;
+    pm.collapses.push_back(rec);
+    neighbours(vs, ns_);
+    for (int w : ns_) push_edge(vs, w);
+    return true;
+  }
+
+  const RowMatXd& P_;
+  const ProgressiveMeshOptions& opt_;
+  int d_, nv_;
+  int alive_count_ = 0;
+  std::vector<std::array<int, 3>> faces_;
+  std::vector<char> face_alive_, vertex_alive_;
+  std::vector<std::vector<int>> vf_;
+  std::vector<std::uint32_t> stamp_;
+  std::vector<detail::QuadricND> quadric_;
+  std::vector<double> area_;
+  std::vector<int> nt_, ns_;
+  std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;
+};
+
+}  // namespace
+
+Result<ProgressiveMesh> build_progressive_mesh(const RowMatXd& P, const RowMat3i& F,
+                                               const ProgressiveMeshOptions& options,
+                                               const ProgressFn& progress) {
+  if (P.cols() < 3 || P.cols() % 3 != 0)
+    return Status(ErrorCode::InvalidArgument, "vertex coordinates must have 3n columns");
+  if (F.rows() < 4 || P.rows() < 4)
+    return Status(ErrorCode::InvalidInput, "mesh has fewer than 4 vertices or faces");
+  if (!options.face_weights.empty() && options.face_weights.size() != static_cast<size_t>(F.rows()))
+    return Status(ErrorCode::InvalidArgument, "face_weights must have one entry per face");
+  if (!options.keep_vertices.empty() && options.keep_vertices.size() != static_cast<size_t>(P.rows()))
+    return Status(ErrorCode::InvalidArgument, "keep_vertices must have one entry per vertex");
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) < 0 || F(f, k) >= P.rows())
+        return Status(ErrorCode::InvalidInput, "face index out of range");
+  ProgressiveMesh pm;
+  pm.num_vertices = static_cast<int>(P.rows());
+  pm.F = F;
+  pm.collapses.reserve(static_cast<size_t>(P.rows()));
+  Simplifier s(P, F, options);
+  SPHEREKIT_RETURN_IF_ERROR(s.run(pm, progress));
+  return pm;
+}
+
+}  // namespace spherekit

@@ -1,0 +1,332 @@
+// Coarse-to-fine embedding of a progressive mesh on the unit sphere.
+//   Praun & Hoppe 2003, "Spherical parametrization and remeshing" §4: base tetrahedron on a
+//   regular tetrahedron, vertex splits replayed one at a time, each new vertex placed in the
+//   kernel of its spherical 1-ring, global stretch passes whenever #V grows by a factor.
+//
+// Invariant (checked by exact predicate at every placement and move): every alive face has
+// det[S(a), S(b), S(c)] > 0. A vertex split changes only faces containing the new vertex vt,
+// so placing vt strictly inside the kernel of its ring preserves the invariant; the kernel
+// is non-empty in exact arithmetic (points next to vs between vl and vr are inside).
+#include "detail/sphere_embedding.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <cstdio>
+#include <cstdlib>
+
+#include "spherekit/predicates.h"
+
+namespace spherekit::detail {
+namespace {
+
+// Kernel "centroid" of v's ring: for each ring edge's great circle, the arc of it that lies
+// in every other constraint half-space is a side of the (convex) kernel polygon; average
+// the arcs' midpoints weighted by arc length, and normalize (Praun & Hoppe's approximation
+// of the kernel centroid, here length-weighted so slivers of the boundary count little).
+bool kernel_centroid(const RingScratch& ring, Eigen::Vector3d* out) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  const size_t n = ring.faces.size();
+  for (size_t i = 0; i < n; ++i) {
+    const auto& fi = ring.faces[i];
+    double nn = fi.n.norm();
+    if (!(nn > 0)) continue;
+    Eigen::Vector3d u = fi.qa;
+    Eigen::Vector3d w = (fi.n / nn).cross(u);
+    double wn = w.norm();
+    if (!(wn > 0)) continue;
+    w /= wn;
+    bool have = false, empty = false;
+    double lo = 0, hi = 0;
+    for (size_t j = 0; j < n && !empty; ++j) {
+      if (j == i) continue;
+      const Eigen::Vector3d& m = ring.faces[j].n;
+      double cu = m.dot(u), cw = m.dot(w);
+      if (cu == 0 && cw == 0) continue;  // same great circle: no constraint along it
+      double phi = std::atan2(cw, cu);
+      if (!have) {
+        lo = phi - M_PI / 2;
+        hi = phi + M_PI / 2;
+        have = true;
+        continue;
+      }
+      double mid = 0.5 * (lo + hi);
+      while (phi - mid > M_PI) phi -= 2 * M_PI;
+      while (phi - mid < -M_PI) phi += 2 * M_PI;
+      lo = std::max(lo, phi - M_PI / 2);
+      hi = std::min(hi, phi + M_PI / 2);
+      if (!(hi > lo)) empty = true;
+    }
+    if (!have || empty) continue;
+    double t = 0.5 * (lo + hi);
+    sum += (hi - lo) * (std::cos(t) * u + std::sin(t) * w);
+  }
+  double len = sum.norm();
+  if (!(len > 0)) return false;
+  *out = sum / len;
+  return true;
+}
+
+// Fallback placement: maximize min_f n_f . x over unit x (the spherical Chebyshev centre of
+// the kernel) by projected subgradient ascent from `start`. Used only when the centroid is
+// not strictly inside by the exact test (very thin kernels).
+bool kernel_chebyshev(const RingScratch& ring, const Eigen::Vector3d& start, Eigen::Vector3d* out) {
+  std::vector<Eigen::Vector3d> nrm;
+  for (const auto& rf : ring.faces) {
+    double l = rf.n.norm();
+    if (l > 0) nrm.push_back(rf.n / l);
+  }
+  Eigen::Vector3d x = start.normalized();
+  double step = 0.25;
+  for (int it = 0; it < 400; ++it) {
+    double best = 1e300;
+    int arg = -1;
+    for (size_t k = 0; k < nrm.size(); ++k) {
+      double s = nrm[k].dot(x);
+      if (s < best) { best = s; arg = static_cast<int>(k); }
+    }
+    if (arg < 0) return false;
+    if (best > 0 && ring_valid_exact(ring, x)) {
+      *out = x;
+      return true;
+    }
+    x = (x + step * nrm[static_cast<size_t>(arg)]).normalized();
+    step *= 0.97;
+  }
+  return false;
+}
+
+// Last-resort placement next to vs: in exact arithmetic every point close enough to vs
+// inside the wedge between vl and vr is in the kernel, so probe directions around vs at
+// shrinking distances and keep the first point the exact predicate accepts.
+bool kernel_near_vertex(const RingScratch& ring, const Eigen::Vector3d& vs, Eigen::Vector3d* out) {
+  Eigen::Vector3d e1 = (std::abs(vs.x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY());
+  e1 = (e1 - vs * vs.dot(e1)).normalized();
+  Eigen::Vector3d e2 = vs.cross(e1);
+  for (double eps = 1e-2; eps > 1e-15; eps *= 0.1)
+    for (int k = 0; k < 64; ++k) {
+      double t = 2 * M_PI * (k + 0.5) / 64;
+      Eigen::Vector3d x = (vs + eps * (std::cos(t) * e1 + std::sin(t) * e2)).normalized();
+      if (ring_valid_exact(ring, x)) {
+        *out = x;
+        return true;
+      }
+    }
+  return false;
+}
+
+class Refiner {
+ public:
+  Refiner(const EmbedInput& in, const OptimizerSettings& s, const ProgressFn& progress, EmbedStats* stats)
+      : in_(in), pm_(*in.pm), s_(s), progress_(progress), stats_(stats) {}
+
+  Status run(RowMat3d* S) {
+    init_base_level();
+    SPHEREKIT_RETURN_IF_ERROR(place_base());
+    const int total = static_cast<int>(pm_.collapses.size());
+    // The base level is optimized as a coarse level only if finer levels follow; a mesh that
+    // is its own base gets just the final pass below.
+    if (total > 0) SPHEREKIT_RETURN_IF_ERROR(optimize_level());
+    int threshold = next_threshold(st_.alive_vertices);
+    int last_pct = -1;
+    for (int i = total - 1; i >= 0; --i) {
+      apply_split(i);
+      SPHEREKIT_RETURN_IF_ERROR(place_new_vertex(i));
+      if (getenv("SK_DEBUG")) debug_min("split", i);
+      if (st_.alive_vertices >= threshold) {
+        SPHEREKIT_RETURN_IF_ERROR(optimize_level());
+        threshold = next_threshold(st_.alive_vertices);
+      }
+      int pct = static_cast<int>(100.0 * (total - i) / std::max(1, total));
+      if (pct != last_pct) {
+        last_pct = pct;
+        if (!report_progress(progress_, "refine", st_.alive_vertices, static_cast<double>(total - i) / std::max(1, total)))
+          return Status(ErrorCode::Cancelled, "cancelled during refinement");
+      }
+    }
+    // Final pass at full resolution on exactly the measured energy (no accordion split).
+    OptimizerSettings final_settings = s_;
+    final_settings.split_distance = 0.0;
+    SPHEREKIT_RETURN_IF_ERROR(optimize_level(final_settings));
+    *S = st_.S;
+    return Status();
+  }
+
+ private:
+  void debug_min(const char* what, int i) {
+    double mn = 1e9; int arg = -1;
+    for (size_t f = 0; f < st_.F.size(); ++f) if (st_.face_alive[f]) {
+      auto& c = st_.F[f];
+      Eigen::Vector3d a = st_.S.row(c[0]), b = st_.S.row(c[1]), cc = st_.S.row(c[2]);
+      double d = a.dot(b.cross(cc)) / ((b-a).norm() * (cc-a).norm() * (cc-b).norm());
+      if (d < mn) { mn = d; arg = (int)f; }
+    }
+    static double last = 1e9;
+    if (mn < 0.1 * last || mn < 1e-6) { fprintf(stderr, "%s %d alive %d min quality %g face %d\n", what, i, st_.alive_vertices, mn, arg); last = mn; }
+  }
+  int next_threshold(int nv) const {
+    // Extra optimization at coarse levels (ratio sqrt(r) up to 1000 vertices), as the
+    // reference implementation does: coarse levels decide the global layout.
+    static const bool coarse_extra = getenv("SK_COARSE") == nullptr || atoi(getenv("SK_COARSE")) != 0;
+    double r = nv <= 1000 && coarse_extra ? std::sqrt(s_.nv_ratio) : s_.nv_ratio;
+    return std::max(nv + 1, static_cast<int>(std::lround(nv * r)));
+  }
+
+  void init_base_level() {
+    const int nv = pm_.num_vertices;
+    const int nf = static_cast<int>(pm_.F.rows());
+    st_.P = in_.P;
+    st_.models = static_cast<int>(in_.P->cols() / 3);
+    st_.F.resize(static_cast<size_t>(nf));
+    for (int f = 0; f < nf; ++f) st_.F[static_cast<size_t>(f)] = {pm_.F(f, 0), pm_.F(f, 1), pm_.F(f, 2)};
+    st_.face_alive.assign(static_cast<size_t>(nf), 1);
+    st_.vertex_alive.assign(static_cast<size_t>(nv), 1);
+    st_.face_weight = in_.face_weight.empty() ? std::vector<double>(static_cast<size_t>(nf), 1.0) : in_.face_weight;
+    st_.fixed = in_.fixed;
+    // Replay the collapses forward to recover the base level's corners.
+    for (const auto& c : pm_.collapses) {
+      for (int f : c.removed) st_.face_alive[static_cast<size_t>(f)] = 0;
+      for (int j = c.moved_begin; j < c.moved_end; ++j)
+        for (int& v : st_.F[static_cast<size_t>(pm_.moved_faces[static_cast<size_t>(j)])])
+          if (v == c.vt) v = c.vs;
+      st_.vertex_alive[static_cast<size_t>(c.vt)] = 0;
+    }
+    st_.vf.assign(static_cast<size_t>(nv), {});
+    for (int f = 0; f < nf; ++f)
+      if (st_.face_alive[static_cast<size_t>(f)])
+        for (int v : st_.F[static_cast<size_t>(f)]) st_.vf[static_cast<size_t>(v)].push_back(f);
+    st_.alive_vertices = nv - static_cast<int>(pm_.collapses.size());
+    st_.S = RowMat3d::Zero(nv, 3);
+  }
+
+  Status place_base() {
+    if (in_.base_positions.rows() == st_.S.rows()) {
+      for (int v : pm_.base_vertices) st_.S.row(v) = in_.base_positions.row(v).normalized();
+    } else {
+      if (pm_.base_vertices.size() != 4 || pm_.base_faces.size() != 4)
+        return Status(ErrorCode::SolverFailed, "progressive mesh base is not a tetrahedron (" +
+                                                   std::to_string(pm_.base_vertices.size()) + " vertices)");
+      // Regular tetrahedron inscribed in the unit sphere; base face 0's corners get T0, T1,
+      // T2 in ccw order with det[T0,T1,T2] > 0, so orientation is preserved.
+      const double k = 1.0 / std::sqrt(3.0);
+      Eigen::Vector3d T[4] = {{k, k, k}, {k, -k, -k}, {-k, k, -k}, {-k, -k, k}};
+      if (orient3d_origin(T[0], T[1], T[2]) < 0) std::swap(T[1], T[2]);
+      const auto& f0 = st_.F[static_cast<size_t>(pm_.base_faces[0])];
+      int d = -1;
+      for (int v : pm_.base_vertices)
+        if (v != f0[0] && v != f0[1] && v != f0[2]) d = v;
+      st_.S.row(f0[0]) = T[0].transpose();
+      st_.S.row(f0[1]) = T[1].transpose();
+      st_.S.row(f0[2]) = T[2].transpose();
+      st_.S.row(d) = T[3].transpose();
+    }
+    for (int f : pm_.base_faces) {
+      const auto& c = st_.F[static_cast<size_t>(f)];
+      if (orient3d_origin(st_.S.row(c[0]).data(), st_.S.row(c[1]).data(), st_.S.row(c[2]).data()) <= 0)
+        return Status(ErrorCode::SolverFailed, "base mesh is not consistently oriented on the sphere");
+    }
+    return Status();
+  }
+
+  void apply_split(int i) {
+    const auto& c = pm_.collapses[static_cast<size_t>(i)];
+    st_.vertex_alive[static_cast<size_t>(c.vt)] = 1;
+    ++st_.alive_vertices;
+    auto& vs_faces = st_.vf[static_cast<size_t>(c.vs)];
+    for (int j = c.moved_begin; j < c.moved_end; ++j) {
+      int f = pm_.moved_faces[static_cast<size_t>(j)];
+      for (int& v : st_.F[static_cast<size_t>(f)])
+        if (v == c.vs) v = c.vt;
+      vs_faces.erase(std::find(vs_faces.begin(), vs_faces.end(), f));
+      st_.vf[static_cast<size_t>(c.vt)].push_back(f);
+    }
+    for (int s = 0; s < 2; ++s) {
+      int f = c.removed[static_cast<size_t>(s)];
+      st_.F[static_cast<size_t>(f)] = pm_.removed_corners[2 * static_cast<size_t>(i) + static_cast<size_t>(s)];
+      st_.face_alive[static_cast<size_t>(f)] = 1;
+      for (int v : st_.F[static_cast<size_t>(f)]) st_.vf[static_cast<size_t>(v)].push_back(f);
+    }
+  }
+
+  Status place_new_vertex(int i) {
+    const int vt = pm_.collapses[static_cast<size_t>(i)].vt;
+    load_ring(st_, vt, ring_);
+    Eigen::Vector3d x;
+    bool ok = kernel_centroid(ring_, &x) && ring_valid_exact(ring_, x);
+    if (!ok) {
+      ++stats_->fallback_placements;
+      Eigen::Vector3d start = st_.S.row(pm_.collapses[static_cast<size_t>(i)].vs).transpose();
+      Eigen::Vector3d c;
+      if (kernel_centroid(ring_, &c)) start = c;
+      ok = kernel_chebyshev(ring_, start, &x) ||
+           kernel_near_vertex(ring_, st_.S.row(pm_.collapses[static_cast<size_t>(i)].vs).transpose(), &x);
+    }
+    if (!ok && getenv("SK_DEBUG")) {
+      int bad = 0;
+      for (size_t f = 0; f < st_.F.size(); ++f) if (st_.face_alive[f] && st_.F[f][0]!=vt && st_.F[f][1]!=vt && st_.F[f][2]!=vt) {
+        auto& c = st_.F[f]; if (orient3d_origin(st_.S.row(c[0]).data(), st_.S.row(c[1]).data(), st_.S.row(c[2]).data()) <= 0) ++bad; }
+      fprintf(stderr, "split %d vt %d vs %d ring %zu badfaces(other) %d alive %d\n", i, vt, pm_.collapses[i].vs, ring_.faces.size(), bad, st_.alive_vertices);
+      for (auto& rf : ring_.faces) fprintf(stderr, "  face %d a %d b %d  n.vs=%g\n", rf.f, rf.a, rf.b, rf.n.dot(st_.S.row(pm_.collapses[i].vs).transpose()));
+    }
+    if (!ok)
+      return Status(ErrorCode::SolverFailed,
+                    "could not place vertex " + std::to_string(vt) + " inside its spherical kernel");
+    st_.S.row(vt) = x.transpose();
+    std::uint64_t key = s_.seed * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(i);
+    for (int k = 0; k < s_.vsplit_vt_iter; ++k) {
+      Eigen::Vector3d y;
+      if (optimize_vertex(st_, vt, key + static_cast<std::uint64_t>(k) * 7919, s_, ring_, &y, 2))
+        st_.S.row(vt) = y.transpose();
+    }
+    if (s_.vsplit_nei_iter > 0) {
+      load_ring(st_, vt, ring_);
+      std::vector<int> nbrs;
+      for (const auto& rf : ring_.faces) nbrs.push_back(rf.a);
+      for (int k = 0; k < s_.vsplit_nei_iter; ++k)
+        for (int w : nbrs) {
+          if (!st_.fixed.empty() && st_.fixed[static_cast<size_t>(w)]) continue;
+          Eigen::Vector3d y;
+          if (optimize_vertex(st_, w, key ^ (static_cast<std::uint64_t>(w) << 20) ^ static_cast<std::uint64_t>(k), s_, ring_, &y, 2))
+            st_.S.row(w) = y.transpose();
+        }
+    }
+    return Status();
+  }
+
+  Status optimize_level() { return optimize_level(s_); }
+
+  Status optimize_level(const OptimizerSettings& s) {
+    st_.update_areas();
+    for (int g = 0; g < s.global_iter; ++g) {
+      std::uint64_t pass_key = s_.seed * 0xd1b54a32d192ed03ULL + static_cast<std::uint64_t>(stats_->passes) * 0x8cb92ba72f3d8dd7ULL;
+      int rounds = optimize_all(st_, s, pass_key, [&] {
+        return report_progress(progress_, "optimize", st_.alive_vertices, -1.0);
+      });
+      if (rounds < 0) return Status(ErrorCode::Cancelled, "cancelled during optimization");
+      ++stats_->passes;
+      if (getenv("SK_DEBUG")) debug_min("pass", stats_->passes);
+      stats_->rounds += rounds;
+    }
+    return Status();
+  }
+
+  const EmbedInput& in_;
+  const ProgressiveMesh& pm_;
+  const OptimizerSettings& s_;
+  const ProgressFn& progress_;
+  EmbedStats* stats_;
+  SphereState st_;
+  RingScratch ring_;
+};
+
+}  // namespace
+
+Status embed_coarse_to_fine(const EmbedInput& in, const OptimizerSettings& s, const ProgressFn& progress,
+                            RowMat3d* S, EmbedStats* stats) {
+  EmbedStats local;
+  if (!stats) stats = &local;
+  Refiner r(in, s, progress, stats);
+  return r.run(S);
+}
+
+}  // namespace spherekit::detail

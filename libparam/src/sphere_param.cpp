@@ -1,0 +1,140 @@
+// The unconstrained spherical parameterization stage (Praun & Hoppe 2003):
+//   check -> fill holes -> normalize -> progressive mesh -> coarse-to-fine embedding -> measure.
+#include "spherekit/sphere_param.h"
+
+#include <chrono>
+#include <Eigen/SVD>
+#include <cstdio>
+#include <string>
+
+#include "detail/sphere_embedding.h"
+#include "spherekit/check_mesh.h"
+#include "spherekit/fill_holes.h"
+#include "spherekit/metrics.h"
+#include "spherekit/progressive_mesh.h"
+#include "spherekit/version.h"
+
+namespace spherekit {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Digest of the shape-defining options (FNV-1a over their printed values): recorded in
+// provenance so two maps can be compared for "made the same way".
+std::string options_digest(const SphereParamOptions& o) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "reg=%.17g;hole=%.17g;seed=%llu;effort=%d;align=%d", o.regularizer_weight, o.hole_weight,
+                static_cast<unsigned long long>(o.seed), o.effort, o.align_rotation ? 1 : 0);
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const char* p = buf; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+// Rotation that best aligns each face's sphere direction with its surface normal (area
+// weighted): the orthogonal Procrustes problem max sum_f w_f n_f . (R c_f), solved by the SVD
+// of M = sum_f w_f n_f c_f^T (Praun & Hoppe's output alignment). It makes results
+// independent of which base face got which tetrahedron corner, and gives symmetric shapes
+// their radial projection (a regular tetrahedron maps exactly onto itself).
+Eigen::Matrix3d alignment_rotation(const TriMesh& mesh, const RowMat3d& S, int faces) {
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  for (int f = 0; f < faces; ++f) {
+    Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)), p2 = mesh.V.row(mesh.F(f, 2));
+    Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);  // length = 2 area: the weight
+    Eigen::Vector3d c = (S.row(mesh.F(f, 0)) + S.row(mesh.F(f, 1)) + S.row(mesh.F(f, 2))).transpose();
+    double cl = c.norm();
+    if (!(cl > 0)) continue;
+    M += n * (c / cl).transpose();
+  }
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
+  return svd.matrixU() * D * svd.matrixV().transpose();
+}
+
+}  // namespace
+
+Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereParamOptions& options,
+                                              const ProgressFn& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  SphereParamResult result;
+  if (options.effort < 0 || options.effort > 5)
+    return Status(ErrorCode::InvalidArgument, "effort must be in 0..5");
+
+  // 1. Refuse what we cannot map (one precise message).
+  MeshCheck check = check_mesh(mesh);
+  SPHEREKIT_RETURN_IF_ERROR(require_genus0(check, /*allow_boundary=*/true));
+  result.times.check = seconds_since(t_start);
+
+  // 2. Close holes with tagged low-weight faces (removed again from the output).
+  SPHEREKIT_ASSIGN_OR_RETURN(FilledMesh filled, fill_holes(mesh));
+  result.holes_filled = filled.holes;
+  const TriMesh& closed = filled.mesh;
+  const int nf = static_cast<int>(closed.F.rows());
+  std::vector<double> face_weight(static_cast<size_t>(nf), 1.0);
+  for (int f = filled.original_faces; f < nf; ++f) face_weight[static_cast<size_t>(f)] = options.hole_weight;
+
+  // 3. Normalize: centre and scale to unit bounding-box diagonal so that every tolerance in
+  //    the simplifier is relative to the model (stretch efficiency is scale-invariant).
+  Eigen::RowVector3d lo = closed.V.colwise().minCoeff(), hi = closed.V.colwise().maxCoeff();
+  double diag = (hi - lo).norm();
+  if (!(diag > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
+  RowMatXd P = (closed.V.rowwise() - 0.5 * (lo + hi)) / diag;
+
+  // 4. Progressive mesh down to a tetrahedron.
+  auto t0 = std::chrono::steady_clock::now();
+  ProgressiveMeshOptions pmo;
+  pmo.face_weights = face_weight;
+  SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, closed.F, pmo, progress));
+  result.times.simplify = seconds_since(t0);
+  result.base_vertices = static_cast<int>(pm.base_vertices.size());
+
+  // 5. Coarse-to-fine embedding with stretch optimization.
+  t0 = std::chrono::steady_clock::now();
+  detail::OptimizerSettings settings = detail::settings_for_effort(options.effort);
+  settings.regularizer_weight = options.regularizer_weight;
+  settings.seed = options.seed;
+  settings.threads = options.threads;
+  detail::EmbedInput in;
+  in.P = &P;
+  in.pm = &pm;
+  in.face_weight = face_weight;
+  RowMat3d S;
+  detail::EmbedStats stats;
+  SPHEREKIT_RETURN_IF_ERROR(detail::embed_coarse_to_fine(in, settings, progress, &S, &stats));
+  result.times.refine = seconds_since(t0);
+  result.optimization_passes = stats.passes;
+
+  // 6. Rotate to the best alignment with the surface normals. A rotation preserves every
+  //    orientation in exact arithmetic, but rounding of the rotated coordinates could flip a
+  //    tiny triangle, so the rotated map is kept only if the exact check still passes.
+  if (options.align_rotation) {
+    Eigen::Matrix3d R = alignment_rotation(closed, S, nf);
+    RowMat3d rotated = S * R.transpose();
+    rotated.rowwise().normalize();
+    if (count_flipped_faces(closed.F, rotated) == 0) S = rotated;
+  }
+
+  // 7. Check and measure: flips by exact predicate over every face of the closed mesh
+  //    (hole faces included: they are part of the bijection), stretch over the real faces.
+  result.flipped_faces = count_flipped_faces(closed.F, S);
+  std::vector<char> real(static_cast<size_t>(nf), 0);
+  for (int f = 0; f < filled.original_faces; ++f) real[static_cast<size_t>(f)] = 1;
+  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(closed, S, {}, &real));
+  result.efficiency = m.efficiency;
+  result.l2_stretch = m.l2_stretch;
+  result.linf_stretch = m.linf;
+  result.winding = m.winding;
+
+  result.map.S = S.topRows(filled.original_vertices);
+  result.map.provenance.library_version = kVersion;
+  result.map.provenance.method = "unconstrained";
+  result.map.provenance.options_digest = options_digest(options);
+  result.map.provenance.seed = options.seed;
+  result.times.total = seconds_since(t_start);
+  return result;
+}
+
+}  // namespace spherekit

@@ -1,0 +1,482 @@
+// Kernel-constrained stretch minimization on the sphere.
+//   Sander, Snyder, Gortler, Hoppe 2001, "Texture mapping progressive meshes" (L2 stretch,
+//     random-direction line searches constrained to the kernel);
+//   Praun & Hoppe 2003, "Spherical parametrization and remeshing" §4 (the sphere -> surface
+//     stretch on chord triangles, the anti-sliver regularizer, global passes per level);
+//   Brent 1973, "Algorithms for minimization without derivatives" (the 1-D search).
+//
+// Energy of a face with sphere corners q0,q1,q2 (its chord triangle is the domain) and
+// surface corners p0,p1,p2, per model with the surface rescaled to area 4 pi:
+//   E_f = (A_f / A) * [ (a' + c')/2 + w * min(a', c')^-3 ]
+// where a' = |dP/ds|^2, c' = |dP/dt|^2 in an orthonormal frame of the chord triangle.
+// The first term is Sander et al.'s squared L2 stretch weighted by surface area (the
+// quantity the efficiency measures); the second keeps sphere triangles from ballooning over
+// tiny surface regions ("cruft"), as the 2003 paper's inverse-stretch regularizer does.
+//
+// Bijectivity: a move of vertex v is searched only inside its kernel (every ring face keeps
+// det[x, qa, qb] > 0), and accepted only after the exact predicate confirms it. Moves in a
+// round form an independent set (no two moved vertices share a face), so every face has at
+// most one moving corner and the per-vertex checks are sufficient.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <atomic>
+#include <cstdlib>
+
+#include "detail/sphere_state.h"
+#include "spherekit/predicates.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#else
+static int omp_get_max_threads() { return 1; }
+#endif
+
+namespace spherekit::detail {
+namespace {
+
+bool use_gradient_ = getenv("SK_GRADIENT") != nullptr;
+bool count_work_ = getenv("SK_DEBUG_WORK") != nullptr;
+
+constexpr double kFourPi = 4.0 * M_PI;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Per face and model in RingScratch::surf: pv (3), pa (3), pb (3), face weight / model area,
+// area floor, then the surface edge Gram entries |d1|^2, |d2|^2, d1.d2 (d1 = pa - pv,
+// d2 = pb - pv) and the surface area: constant while v moves, so the common case needs no
+// surface arithmetic at all.
+constexpr size_t kSurfStride = 15;
+
+// SplitMix64: a stateless hash, so the random direction of a vertex depends only on
+// (seed, pass, round, vertex) and never on thread scheduling.
+std::uint64_t mix(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+double unit_random(std::uint64_t key) { return static_cast<double>(mix(key) >> 11) * 0x1.0p-53; }
+
+// An orthonormal tangent basis at unit vector x.
+void tangent_basis(const Eigen::Vector3d& x, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
+  Eigen::Vector3d a = std::abs(x.x()) < 0.6 ? Eigen::Vector3d::UnitX()
+                      : std::abs(x.y()) < 0.6 ? Eigen::Vector3d::UnitY()
+                                               : Eigen::Vector3d::UnitZ();
+  e1 = (a - x * x.dot(a)).normalized();
+  e2 = x.cross(e1);
+}
+
+// Brent's method (parabolic interpolation with golden-section fallback) on [lo, hi],
+// starting from x0 with known f(x0). Returns the best point found within `max_eval`
+// evaluations of f.
+template <class Fn>
+double brent_minimize(Fn&& f, double lo, double hi, double x0, double f0, int max_eval, double* fbest) {
+  const double kGolden = 0.3819660112501051;  // (3 - sqrt 5) / 2
+  const double tol_abs = 1e-4 * (hi - lo);     // x-tolerance relative to the interval
+  double a = lo, b = hi;
+  double x = x0, w = x0, v = x0, fx = f0, fw = f0, fv = f0;
+  double d = 0, e = 0;
+  for (int it = 0; it < max_eval; ++it) {
+    double xm = 0.5 * (a + b);
+    double tol1 = tol_abs, tol2 = 2 * tol1;
+    if (std::abs(x - xm) <= tol2 - 0.5 * (b - a)) break;
+    bool golden = true;
+    if (std::abs(e) > tol1) {
+      double r = (x - w) * (fx - fv);
+      double q = (x - v) * (fx - fw);
+      double p = (x - v) * q - (x - w) * r;
+      q = 2 * (q - r);
+      if (q > 0) p = -p;
+      q = std::abs(q);
+      double etemp = e;
+      e = d;
+      if (!(std::abs(p) >= std::abs(0.5 * q * etemp) || p <= q * (a - x) || p >= q * (b - x))) {
+        d = p / q;
+        double u = x + d;
+        if (u - a < tol2 || b - u < tol2) d = xm >= x ? tol1 : -tol1;
+        golden = false;
+      }
+    }
+    if (golden) {
+      e = x >= xm ? a - x : b - x;
+      d = kGolden * e;
+    }
+    double u = std::abs(d) >= tol1 ? x + d : x + (d >= 0 ? tol1 : -tol1);
+    double fu = f(u);
+    if (fu <= fx) {
+      if (u >= x) a = x; else b = x;
+      v = w; fv = fw; w = x; fw = fx; x = u; fx = fu;
+    } else {
+      if (u < x) a = u; else b = u;
+      if (fu <= fw || w == x) {
+        v = w; fv = fw; w = u; fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u; fv = fu;
+      }
+    }
+  }
+  *fbest = fx;
+  return x;
+}
+
+// Feasible interval (lo, hi) around t = 0 of x(t) = x0 cos t + d sin t for the ring's kernel
+// constraints n . x(t) > 0. Each constraint n.x0 cos t + n.d sin t = R cos(t - phi) > 0
+// allows t in (phi - pi/2, phi + pi/2); n.x0 > 0 at t = 0 puts phi in (-pi/2, pi/2).
+bool feasible_interval(const RingScratch& ring, const Eigen::Vector3d& x0, const Eigen::Vector3d& d,
+                       double* lo, double* hi) {
+  double l = -M_PI / 2, h = M_PI / 2;
+  for (const auto& rf : ring.faces) {
+    double alpha = rf.n.dot(x0), beta = rf.n.dot(d);
+    if (!(alpha > 0)) return false;  // current position not strictly inside (rounding)
+    double phi = std::atan2(beta, alpha);
+    l = std::max(l, phi - M_PI / 2);
+    h = std::min(h, phi + M_PI / 2);
+  }
+  if (!(h > 0 && l < 0)) return false;
+  // Pad inward by 1% at each end so no triangle can fully collapse (Praun & Hoppe's margin).
+  double pad = 0.01 * (h - l);
+  *lo = l + pad;
+  *hi = h - pad;
+  return *lo < 0 && *hi > 0;
+}
+
+}  // namespace
+
+void SphereState::update_areas() {
+  model_area.assign(static_cast<size_t>(models), 0.0);
+  for (size_t f = 0; f < F.size(); ++f) {
+    if (!face_alive[f]) continue;
+    for (int m = 0; m < models; ++m) {
+      Eigen::Vector3d p0 = P->row(F[f][0]).segment<3>(3 * m).transpose();
+      Eigen::Vector3d p1 = P->row(F[f][1]).segment<3>(3 * m).transpose();
+      Eigen::Vector3d p2 = P->row(F[f][2]).segment<3>(3 * m).transpose();
+      model_area[static_cast<size_t>(m)] += 0.5 * (p1 - p0).cross(p2 - p0).norm() * face_weight[f];
+    }
+  }
+  int alive = 0;
+  for (char a : face_alive) alive += a ? 1 : 0;
+  area_floor.assign(static_cast<size_t>(models), 0.0);
+  for (int m = 0; m < models; ++m) {
+    double& a = model_area[static_cast<size_t>(m)];
+    if (!(a > 0)) a = 1.0;  // a fully degenerate level (cannot happen for valid input)
+    area_floor[static_cast<size_t>(m)] = 1e-3 * a / std::max(1, alive);
+  }
+}
+
+OptimizerSettings settings_for_effort(int effort) {
+  OptimizerSettings s;
+  switch (std::clamp(effort, 0, 5)) {
+    case 0: s.line_search_iter = 6;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 1e-2; s.nv_ratio = 1.7;  break;
+    case 1: s.line_search_iter = 8;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 5e-3; s.nv_ratio = 1.25; break;
+    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 3;  s.movetol = 1e-3; s.nv_ratio = 1.2;  break;
+    case 3: s.line_search_iter = 40;  s.vsplit_vt_iter = 3; s.vsplit_nei_iter = 3;  s.global_iter = 5;  s.movetol = 1e-3; s.nv_ratio = 1.1;  break;
+    case 4: s.line_search_iter = 100; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 5;  s.global_iter = 8;  s.movetol = 5e-4; s.nv_ratio = 1.05; break;
+    default: s.line_search_iter = 200; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 20; s.global_iter = 20; s.movetol = 3e-4; s.nv_ratio = 1.04; break;
+  }
+  if (getenv("SK_ROUNDS")) s.max_rounds = atoi(getenv("SK_ROUNDS"));
+  if (getenv("SK_GITER")) s.global_iter = atoi(getenv("SK_GITER"));
+  if (getenv("SK_LS")) s.line_search_iter = atoi(getenv("SK_LS"));
+  if (getenv("SK_MOVETOL")) s.movetol = atof(getenv("SK_MOVETOL"));
+  if (getenv("SK_RATIO")) s.nv_ratio = atof(getenv("SK_RATIO"));
+  return s;
+}
+
+bool load_ring(const SphereState& st, int v, RingScratch& ring) {
+  const auto& faces = st.vf[static_cast<size_t>(v)];
+  ring.faces.resize(faces.size());
+  ring.surf.resize(faces.size() * static_cast<size_t>(st.models) * kSurfStride);
+  const RowMatXd& P = *st.P;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    int f = faces[i];
+    const auto& c = st.F[static_cast<size_t>(f)];
+    int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+    auto& rf = ring.faces[i];
+    rf.f = f;
+    rf.a = c[(k + 1) % 3];
+    rf.b = c[(k + 2) % 3];
+    rf.qa = st.S.row(rf.a).transpose();
+    rf.qb = st.S.row(rf.b).transpose();
+    rf.n = rf.qa.cross(rf.qb);
+    for (int m = 0; m < st.models; ++m) {
+      double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
+      for (int d = 0; d < 3; ++d) {
+        s[d] = P(v, 3 * m + d);
+        s[3 + d] = P(rf.a, 3 * m + d);
+        s[6 + d] = P(rf.b, 3 * m + d);
+      }
+      s[9] = st.face_weight[static_cast<size_t>(f)] / st.model_area[static_cast<size_t>(m)];
+      s[10] = st.area_floor[static_cast<size_t>(m)];
+      Eigen::Vector3d d1(s[3] - s[0], s[4] - s[1], s[5] - s[2]), d2(s[6] - s[0], s[7] - s[1], s[8] - s[2]);
+      s[11] = d1.squaredNorm();
+      s[12] = d2.squaredNorm();
+      s[13] = d1.dot(d2);
+      s[14] = 0.5 * d1.cross(d2).norm();
+    }
+  }
+  return !faces.empty();
+}
+
+namespace {
+
+// Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, formed explicitly.
+inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
+                           const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+                           double scale, double floor, double reg_weight) {
+  Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
+  double l1sq = e1.squaredNorm();
+  if (!(l1sq > 0)) return kInf;
+  double l1 = std::sqrt(l1sq);
+  double e2u = e2.dot(e1) / l1;
+  double hsq = e2.squaredNorm() - e2u * e2u;
+  if (!(hsq > 1e-24 * l1sq)) return kInf;  // chord triangle (numerically) collapsed
+  double h = std::sqrt(hsq);
+  Eigen::Vector3d d1 = p1 - p0, d2 = p2 - p0;
+  Eigen::Vector3d Ss = d1 / l1;
+  Eigen::Vector3d St = (d2 - e2u * Ss) / h;
+  double a = Ss.squaredNorm() * scale, c = St.squaredNorm() * scale;
+  double mn = std::min(a, c);
+  double reg = mn > 0 ? reg_weight / (mn * mn * mn) : kInf;
+  double area = 0.5 * d1.cross(d2).norm();
+  return (area + floor) * (0.5 * (a + c) + reg);
+}
+
+// A large face's energy with Praun & Hoppe's split against "accordion" slivers: the vertex i
+// opposite the longest chord edge (j,k) is projected onto the great circle through j,k
+// (point m); the face is evaluated as the two chord triangles (i,j,m) and (i,m,k), with the
+// surface point of m interpolated on edge jk where the chord jk meets the ray through m.
+// A spherical triangle whose corners approach one great circle has m -> q_i, so both
+// halves collapse and the energy grows without bound, although its own chord triangle
+// would stay fat and cheap; for moderately large triangles it charges the bulge of the
+// spherical triangle over its chord, which steers the coarse levels to good layouts.
+inline double split_face_energy(const Eigen::Vector3d* q, const Eigen::Vector3d* p, double scale, double floor,
+                                double reg_weight) {
+  double L0 = (q[1] - q[2]).squaredNorm(), L1 = (q[2] - q[0]).squaredNorm(), L2 = (q[0] - q[1]).squaredNorm();
+  int i = L0 >= L1 ? (L0 >= L2 ? 0 : 2) : (L1 >= L2 ? 1 : 2);
+  int j = (i + 1) % 3, k = (i + 2) % 3;
+  Eigen::Vector3d n = q[j].cross(q[k]);
+  double nn = n.squaredNorm();
+  if (!(nn > 0)) return kInf;
+  Eigen::Vector3d m = q[i] - n * (n.dot(q[i]) / nn);
+  double mlen = m.norm();
+  if (!(mlen > 0)) return kInf;
+  m /= mlen;
+  Eigen::Vector3d A = q[k].cross(m), B = (q[j] - q[k]).cross(m);
+  double bb = B.squaredNorm();
+  if (!(bb > 0)) return kInf;
+  double t = -A.dot(B) / bb;
+  Eigen::Vector3d pm = t * p[j] + (1 - t) * p[k];
+  return chord_energy(q[i], q[j], m, p[i], p[j], pm, scale, 0.5 * floor, reg_weight) +
+         chord_energy(q[i], m, q[k], p[i], pm, p[k], scale, 0.5 * floor, reg_weight);
+}
+
+// Energy of a small face from its Gram entries, without forming the Jacobian: for the affine
+// map with domain edges e1, e2 (from x) and surface edges d1, d2,
+//   a + c = |J|_F^2 = (|e2|^2 |d1|^2 + |e1|^2 |d2|^2 - 2 (e1.e2)(d1.d2)) / (4 A_dom^2),
+// which needs only dot products of the edges.
+inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, const double* s, double scale,
+                          double reg_weight) {
+  double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
+  double four_a2 = E11 * E22 - E12 * E12;  // (2 A_dom)^2
+  if (!(four_a2 > 1e-24 * E11 * E22)) return kInf;
+  double T = (E22 * s[11] + E11 * s[12] - 2 * E12 * s[13]) / four_a2 * scale;
+  // The regularizer uses min(a, c) in the frame with s along e1, as the reference does:
+  // a = |d1|^2 / |e1|^2, c = (a + c) - a.
+  double a = s[11] / E11 * scale;
+  double g = std::min(a, T - a);
+  double reg = g > 0 ? reg_weight / (g * g * g) : kInf;
+  return (s[14] + s[10]) * (0.5 * T + reg);
+}
+
+}  // namespace
+
+std::atomic<long long> g_energy_face_evals{0};
+
+double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x, double reg_weight,
+                   double split_distance) {
+  if (count_work_) g_energy_face_evals.fetch_add(static_cast<long long>(ring.faces.size()), std::memory_order_relaxed);
+  double energy = 0;
+  for (size_t i = 0; i < ring.faces.size(); ++i) {
+    const auto& rf = ring.faces[i];
+    const Eigen::Vector3d e1 = rf.qa - x, e2 = rf.qb - x;
+    // Distance of the chord plane from the centre: 1 for tiny triangles, 1/3 for the faces of
+    // a regular tetrahedron, -> 0 when the corners approach one great circle. Large faces
+    // (chord plane closer than split_distance) take the split evaluation, the others the cheap Gram form.
+    const double twice_flat = e1.cross(e2).norm();
+    const double delta = x.dot(rf.n) / twice_flat;
+    if (!(delta > 0)) return kInf;
+    const bool large = delta < split_distance;
+    for (int m = 0; m < st.models; ++m) {
+      const double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
+      double scale = kFourPi / st.model_area[static_cast<size_t>(m)];
+      if (!large) {
+        energy += s[9] * gram_energy(e1, e2, s, scale, reg_weight);
+      } else {
+        const Eigen::Vector3d q[3] = {x, rf.qa, rf.qb};
+        const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
+                                      Eigen::Vector3d(s[6], s[7], s[8])};
+        energy += s[9] * split_face_energy(q, p, scale, s[10], reg_weight);
+      }
+    }
+    if (!std::isfinite(energy)) return kInf;
+  }
+  return energy;
+}
+
+bool ring_valid_exact(const RingScratch& ring, const Eigen::Vector3d& x) {
+  for (const auto& rf : ring.faces)
+    if (orient3d_origin(x, rf.qa, rf.qb) <= 0) return false;
+  return true;
+}
+
+bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const OptimizerSettings& s,
+                     RingScratch& ring, Eigen::Vector3d* out, int searches) {
+  if (!load_ring(st, v, ring)) return false;
+  Eigen::Vector3d x = st.S.row(v).transpose();
+  double e0 = ring_energy(st, ring, x, s.regularizer_weight, s.split_distance);
+  if (!std::isfinite(e0)) e0 = std::numeric_limits<double>::max();
+  Eigen::Vector3d e1, e2;
+  tangent_basis(x, e1, e2);
+  // First direction: steepest descent in the tangent plane (forward differences with a step
+  // tiny against the ring: 1e-4 of the shortest chord to a neighbour). It converges in far
+  // fewer rounds than a random direction; a random direction is the fallback when the
+  // gradient cannot be formed (e.g. the probe leaves the kernel).
+  double hmin = kInf;
+  for (const auto& rf : ring.faces) hmin = std::min(hmin, (rf.qa - x).norm());
+  Eigen::Vector3d d;
+  bool have_dir = false;
+  if (use_gradient_ && std::isfinite(hmin) && hmin > 0) {
+    double h = 1e-4 * hmin;
+    double g1 = ring_energy(st, ring, (x + h * e1).normalized(), s.regularizer_weight, s.split_distance);
+    double g2 = ring_energy(st, ring, (x + h * e2).normalized(), s.regularizer_weight, s.split_distance);
+    if (std::isfinite(g1) && std::isfinite(g2) && e0 < std::numeric_limits<double>::max()) {
+      Eigen::Vector3d g = (g1 - e0) * e1 + (g2 - e0) * e2;
+      double gn = g.norm();
+      if (gn > 0) {
+        d = -g / gn;
+        have_dir = true;
+      }
+    }
+  }
+  if (!have_dir) {
+    double theta = 2 * M_PI * unit_random(key);
+    d = std::cos(theta) * e1 + std::sin(theta) * e2;
+  }
+  bool improved = false;
+  double ecur = e0;
+  for (int k = 0; k < searches; ++k) {
+    double lo, hi;
+    if (feasible_interval(ring, x, d, &lo, &hi)) {
+      auto f = [&](double t) {
+        Eigen::Vector3d y = x * std::cos(t) + d * std::sin(t);
+        return ring_energy(st, ring, y, s.regularizer_weight, s.split_distance);
+      };
+      double fbest;
+      double t = brent_minimize(f, lo, hi, 0.0, ecur, s.line_search_iter, &fbest);
+      if (t != 0.0 && fbest < ecur) {
+        Eigen::Vector3d y = (x * std::cos(t) + d * std::sin(t)).normalized();
+        if (ring_valid_exact(ring, y)) {
+          double ey = ring_energy(st, ring, y, s.regularizer_weight, s.split_distance);
+          if (ey < ecur) {
+            // Keep the search direction continuous: transport d to the new point.
+            Eigen::Vector3d dn = (d * std::cos(t) - x * std::sin(t));
+            x = y;
+            ecur = ey;
+            d = dn;
+            improved = true;
+          }
+        }
+      }
+    }
+    // Next search along the perpendicular great circle (Praun & Hoppe 2003).
+    d = x.cross(d).normalized();
+  }
+  if (improved) *out = x;
+  return improved;
+}
+
+int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
+                 const std::function<bool()>& keep_going) {
+  const int nv = static_cast<int>(st.S.rows());
+  std::vector<double> credit(static_cast<size_t>(nv), 0.0);
+  std::vector<int> active;
+  for (int v = 0; v < nv; ++v)
+    if (st.vertex_alive[static_cast<size_t>(v)] && !(st.fixed.size() && st.fixed[static_cast<size_t>(v)])) {
+      credit[static_cast<size_t>(v)] = 3.0;
+      active.push_back(v);
+    }
+  struct Candidate {
+    Eigen::Vector3d x;
+    double dist;
+    bool moved;
+  };
+  std::vector<Candidate> cand;
+  std::vector<char> locked(static_cast<size_t>(nv), 0);
+  std::vector<int> order, next;
+  int threads = s.threads > 0 ? s.threads : 0;
+  int round = 0;
+  for (; round < s.max_rounds && !active.empty(); ++round) {
+    if (keep_going && !keep_going()) return -1;
+    cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
+    const int na = static_cast<int>(active.size());
+    // Candidates are computed from the same positions by every thread: results do not
+    // depend on the thread count or scheduling.
+#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads()) if (na > 256)
+    {
+      RingScratch ring;
+#pragma omp for schedule(dynamic, 64)
+      for (int i = 0; i < na; ++i) {
+        int v = active[static_cast<size_t>(i)];
+        std::uint64_t key = mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
+        Eigen::Vector3d y;
+        if (optimize_vertex(st, v, key, s, ring, &y, 2)) {
+          cand[static_cast<size_t>(i)].x = y;
+          cand[static_cast<size_t>(i)].dist = (y - st.S.row(v).transpose()).norm();
+          cand[static_cast<size_t>(i)].moved = true;
+        }
+      }
+    }
+    // Apply greedily as an independent set, largest displacement first (ties by id).
+    order.resize(active.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::sort(order.begin(), order.end(), [&](int a, int b) {
+      if (cand[a].dist != cand[b].dist) return cand[a].dist > cand[b].dist;
+      return active[a] < active[b];
+    });
+    std::fill(locked.begin(), locked.end(), 0);
+    for (int i : order) {
+      int v = active[static_cast<size_t>(i)];
+      if (locked[static_cast<size_t>(v)]) continue;  // a neighbour moved: retry next round
+      credit[static_cast<size_t>(v)] = 0;
+      if (!cand[static_cast<size_t>(i)].moved) continue;
+      st.S.row(v) = cand[static_cast<size_t>(i)].x.transpose();
+      for (int f : st.vf[static_cast<size_t>(v)])
+        for (int k = 0; k < 3; ++k) {
+          int w = st.F[static_cast<size_t>(f)][k];
+          if (w == v) continue;
+          locked[static_cast<size_t>(w)] = 1;
+          // "Spatial fade": neighbours of a moved vertex gain credit (REFERENCE.md §2.5).
+          credit[static_cast<size_t>(w)] += 0.3 * cand[static_cast<size_t>(i)].dist / 2.0;
+        }
+    }
+    next.clear();
+    for (int v : active)
+      if (credit[static_cast<size_t>(v)] > s.movetol || locked[static_cast<size_t>(v)]) next.push_back(v);
+    // Neighbours of movers that were inactive may have gained enough credit.
+    for (int i : order) {
+      if (!cand[static_cast<size_t>(i)].moved) continue;
+      int v = active[static_cast<size_t>(i)];
+      for (int f : st.vf[static_cast<size_t>(v)])
+        for (int k = 0; k < 3; ++k) {
+          int w = st.F[static_cast<size_t>(f)][k];
+          if (w != v && credit[static_cast<size_t>(w)] > s.movetol && !(st.fixed.size() && st.fixed[static_cast<size_t>(w)]))
+            next.push_back(w);
+        }
+    }
+    std::sort(next.begin(), next.end());
+    next.erase(std::unique(next.begin(), next.end()), next.end());
+    active.swap(next);
+  }
+  return round;
+}
+
+}  // namespace spherekit::detail

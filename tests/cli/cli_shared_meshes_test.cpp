@@ -1,0 +1,120 @@
+// `spherekit` on the developer meshes in ../shared/meshes (skipped with a message when that
+// folder is absent): check agrees with the manifest, and eval agrees with the independent
+// evaluator shared/tools/evalsphere.py.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "test_paths.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// Runs a shell command with stdout captured to `out_file` (stderr to out_file + ".err");
+// returns the exit code.
+int run(const std::string& cmd, const std::string& out_file) {
+  const int status = std::system((cmd + " </dev/null >" + quote(out_file) + " 2>" + quote(out_file + ".err")).c_str());
+  return (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+TEST_CASE("shared meshes: check --json matches the manifest on every shared mesh", "[cli][shared]") {
+  SPHEREKIT_REQUIRE_SHARED_MESHES(meshes);
+  const json manifest = json::parse(slurp(meshes + "/manifest.json"));
+  REQUIRE(manifest.is_array());
+  REQUIRE_FALSE(manifest.empty());
+
+  // One process for all files: the point is also that a whole corpus checks in one call.
+  std::string args;
+  for (const json& entry : manifest) args += " " + quote(meshes + "/" + entry["file"].get<std::string>());
+  const std::string dir = spherekit::test::temp_dir("cli_shared_check");
+  const std::string out = dir + "/check.json";
+  const int code = run(quote(SPHEREKIT_EXE) + " check --json" + args, out);
+  INFO("stderr: " << slurp(out + ".err"));
+  CHECK(code == 0);  // every shared mesh is genus 0 (some with holes)
+
+  const json report = json::parse(slurp(out), nullptr, false);
+  REQUIRE_FALSE(report.is_discarded());
+  REQUIRE(report.size() == manifest.size());
+  for (size_t i = 0; i < manifest.size(); ++i) {
+    const json& want = manifest[i];
+    const json& got = report[i];
+    INFO(want["file"].get<std::string>());
+    REQUIRE_FALSE(got.contains("error"));
+    CHECK(got["genus"] == want["genus"]);
+    CHECK(got["boundary_loops"] == want["boundary_loops"]);
+    CHECK(got["components"] == want["components"]);
+    CHECK(got["V"] == want["V"]);
+    CHECK(got["F"] == want["F"]);
+    const json& check = want["check"];
+    for (const char* key : {"edges", "boundary_edges", "nonmanifold_edges", "nonmanifold_vertices", "euler",
+                            "degenerate_faces", "duplicate_faces", "unreferenced_vertices"})
+      if (check.contains(key)) CHECK(got[key] == check[key]);
+    CHECK(got["genus0_ok"] == true);
+  }
+}
+
+TEST_CASE("shared meshes: eval agrees with evalsphere.py on small shared meshes", "[cli][shared]") {
+  SPHEREKIT_REQUIRE_SHARED_MESHES(meshes);
+  const std::string evalsphere = fs::path(meshes).parent_path().string() + "/tools/evalsphere.py";
+  // The Debian interpreter first: python3-numpy is installed for it, while a python3 found
+  // earlier on PATH (pyenv, venv) may lack numpy.
+  std::string python;
+  for (const char* candidate : {"/usr/bin/python3", "python3"})
+    if (std::system((std::string(candidate) + " -c 'import numpy' >/dev/null 2>&1").c_str()) == 0) {
+      python = candidate;
+      break;
+    }
+  if (!fs::exists(evalsphere) || python.empty()) {
+    WARN("SKIPPED: shared/tools/evalsphere.py or python3-numpy missing");
+    return;
+  }
+  const std::string dir = spherekit::test::temp_dir("cli_shared_eval");
+  // knight: closed; woody: one hole (measured over its real faces).
+  for (const std::string& name : {std::string("knight"), std::string("woody")}) {
+    INFO(name);
+    const std::string mesh = meshes + "/" + name + ".obj";
+    const std::string sphere = dir + "/" + name + ".sphere.obj";
+    REQUIRE(run(quote(SPHEREKIT_EXE) + " param " + quote(mesh) + " -o " + quote(sphere) + " --quiet",
+                dir + "/param.txt") == 0);
+    REQUIRE(run(quote(SPHEREKIT_EXE) + " eval --json " + quote(mesh) + " " + quote(sphere), dir + "/ours.json") == 0);
+    REQUIRE(run(python + " " + quote(evalsphere) + " " + quote(mesh) + " " + quote(sphere), dir + "/theirs.json") == 0);
+    const json ours = json::parse(slurp(dir + "/ours.json"));
+    const json theirs = json::parse(slurp(dir + "/theirs.json"));
+    INFO("ours:   " << ours.dump());
+    INFO("theirs: " << theirs.dump());
+    CHECK(ours["vertices"] == theirs["vertices"]);
+    CHECK(ours["faces"] == theirs["faces"]);
+    CHECK(ours["flipped"] == theirs["flipped"]);
+    CHECK(ours["closed"] == theirs["closed"]);
+    for (const char* key : {"efficiency", "linf", "conformal_mean", "area_log_mean", "winding", "fold_excess"}) {
+      if (!theirs.contains(key)) {
+        CHECK_FALSE(ours.contains(key));
+        continue;
+      }
+      const double a = ours[key].get<double>(), b = theirs[key].get<double>();
+      INFO(key);
+      CHECK(std::abs(a - b) <= 1e-3 * std::max(1.0, std::abs(b)));
+    }
+  }
+}

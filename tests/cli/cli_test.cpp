@@ -1,0 +1,449 @@
+// End-to-end tests of the `spherekit` program: exit codes, one-line error messages that
+// name the file, no output (and no temporary file) left behind on failure, and valid
+// outputs on success. Inputs are generated here into per-test temporary folders.
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "spherekit/version.h"
+#include "test_meshes.h"
+#include "test_paths.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using spherekit::TriMesh;
+
+namespace {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// Runs `spherekit ARGS` with stdout/stderr captured into files of `capture_dir` (never the
+// folder whose contents a test inspects).
+CliRun run_cli(const std::string& args, const std::string& capture_dir) {
+  const std::string out = capture_dir + "/stdout.txt", err = capture_dir + "/stderr.txt";
+  const std::string cmd =
+      quote(SPHEREKIT_EXE) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.exit_code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::string obj_text(const TriMesh& m) {
+  std::string s;
+  char buf[128];
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    std::snprintf(buf, sizeof buf, "v %.17g %.17g %.17g\n", m.V(i, 0), m.V(i, 1), m.V(i, 2));
+    s += buf;
+  }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    std::snprintf(buf, sizeof buf, "f %d %d %d\n", m.F(f, 0) + 1, m.F(f, 1) + 1, m.F(f, 2) + 1);
+    s += buf;
+  }
+  return s;
+}
+
+std::string write_obj(const std::string& dir, const std::string& name, const TriMesh& m) {
+  const std::string path = dir + "/" + name;
+  write_text(path, obj_text(m));
+  return path;
+}
+
+// Binary little-endian PLY (float x y z, uchar/int lists) with the given vertex count in
+// the header, which lets a test lie about it.
+std::string binary_ply(const TriMesh& m, long header_vertices) {
+  std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(header_vertices) +
+                  "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                  std::to_string(m.F.rows()) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  auto put = [&](const void* p, size_t n) { s.append(static_cast<const char*>(p), n); };
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const float x = static_cast<float>(m.V(i, k));
+      put(&x, 4);
+    }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const unsigned char n = 3;
+    put(&n, 1);
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t v = m.F(f, k);
+      put(&v, 4);
+    }
+  }
+  return s;
+}
+
+std::vector<std::string> files_in(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+int count_lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+// The contract for every failure: exactly one line on stderr, `spherekit: error: ...`,
+// naming the offending file.
+void require_one_line_error(const CliRun& r, const std::string& file) {
+  INFO("stderr: " << r.err);
+  CHECK(count_lines(r.err) == 1);
+  CHECK(r.err.rfind("spherekit: error: ", 0) == 0);
+  CHECK(r.err.find(fs::path(file).filename().string()) != std::string::npos);
+}
+
+// Vertex positions of an OBJ, parsed here (independently of formats/).
+std::vector<Eigen::Vector3d> obj_vertices(const std::string& path) {
+  std::vector<Eigen::Vector3d> V;
+  std::istringstream in(slurp(path));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("v ", 0) != 0) continue;
+    std::istringstream f(line.substr(2));
+    Eigen::Vector3d p;
+    f >> p.x() >> p.y() >> p.z();
+    V.push_back(p);
+  }
+  return V;
+}
+
+json parse_json(const std::string& text) {
+  json j = json::parse(text, nullptr, false);
+  INFO("text: " << text);
+  REQUIRE_FALSE(j.is_discarded());
+  return j;
+}
+
+}  // namespace
+
+TEST_CASE("help and version flags exit 0", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_help");
+  CliRun help = run_cli("--help", dir);
+  CHECK(help.exit_code == 0);
+  for (const char* cmd : {"check", "param", "eval", "samples", "bench", "run"}) {
+    CHECK(help.out.find(cmd) != std::string::npos);
+    CliRun sub = run_cli(std::string(cmd) + " --help", dir);
+    INFO(cmd);
+    CHECK(sub.exit_code == 0);
+    CHECK(sub.out.find("Examples:") != std::string::npos);
+  }
+  CliRun version = run_cli("--version", dir);
+  CHECK(version.exit_code == 0);
+  CHECK(version.out.find(spherekit::kVersion) != std::string::npos);
+}
+
+TEST_CASE("usage errors exit 2 with one line", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_usage");
+  const std::string mesh = write_obj(dir, "blob.obj", spherekit::test::random_blob(1, 3));
+  for (const std::string& args : {std::string(""), std::string("frobnicate"), "check --no-such-flag " + mesh,
+                                 "param " + mesh + " -o " + dir + "/x.obj --effort 9", "param " + mesh,
+                                 "check " + mesh + " --repair"}) {
+    INFO("args: " << args);
+    CliRun r = run_cli(args, dir);
+    CHECK(r.exit_code == 2);
+    CHECK(count_lines(r.err) == 1);
+    CHECK(r.err.rfind("spherekit: error: ", 0) == 0);
+  }
+  CHECK_FALSE(fs::exists(dir + "/x.obj"));
+}
+
+TEST_CASE("check reports a good mesh as genus 0", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_check_good");
+  const TriMesh blob = spherekit::test::random_blob(2, 7);
+  const std::string mesh = write_obj(dir, "blob.obj", blob);
+
+  CliRun r = run_cli("check --json " + quote(mesh), dir);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  json j = parse_json(r.out);
+  REQUIRE(j.is_array());
+  REQUIRE(j.size() == 1);
+  CHECK(j[0]["file"] == mesh);
+  CHECK(j[0]["V"] == blob.V.rows());
+  CHECK(j[0]["F"] == blob.F.rows());
+  CHECK(j[0]["genus"] == 0);
+  CHECK(j[0]["euler"] == 2);
+  CHECK(j[0]["components"] == 1);
+  CHECK(j[0]["boundary_loops"] == 0);
+  CHECK(j[0]["genus0_ok"] == true);
+  for (const char* key : {"edges", "unreferenced_vertices", "degenerate_faces", "duplicate_faces", "zero_area_faces",
+                          "boundary_edges", "nonmanifold_edges", "orientation_conflicts", "nonmanifold_vertices",
+                          "orientable", "bbox_diag"})
+    CHECK(j[0].contains(key));
+
+  CliRun human = run_cli("check " + quote(mesh), dir);
+  CHECK(human.exit_code == 0);
+  CHECK(human.out.find("ok: genus-0 (0 holes)") != std::string::npos);
+}
+
+TEST_CASE("check accepts holes and refuses genus 1 with exit 3", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_check_topology");
+  const std::string holes = write_obj(dir, "holes.obj", spherekit::test::sphere_with_holes(2, 3));
+  const std::string torus = write_obj(dir, "torus.obj", spherekit::test::torus());
+
+  CliRun ok = run_cli("check " + quote(holes), dir);
+  CHECK(ok.exit_code == 0);
+  CHECK(ok.out.find("ok: genus-0 (3 holes)") != std::string::npos);
+
+  CliRun bad = run_cli("check --json " + quote(torus), dir);
+  CHECK(bad.exit_code == 3);
+  require_one_line_error(bad, torus);
+  json j = parse_json(bad.out);
+  CHECK(j[0]["genus"] == 1);
+  CHECK(j[0]["genus0_ok"] == false);
+
+  // Several files: the worst verdict wins, every file still reported.
+  CliRun both = run_cli("check --json " + quote(holes) + " " + quote(torus), dir);
+  CHECK(both.exit_code == 3);
+  CHECK(parse_json(both.out).size() == 2);
+}
+
+TEST_CASE("check --repair splits a pinched vertex", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_repair");
+  const std::string pinched = write_obj(dir, "pinched.obj", spherekit::test::pinched_tetrahedra());
+  const std::string fixed = dir + "/fixed.obj";
+
+  CliRun before = run_cli("check --json " + quote(pinched), dir);
+  CHECK(before.exit_code == 3);
+  CHECK(parse_json(before.out)[0]["nonmanifold_vertices"] == 1);
+
+  CliRun r = run_cli("check --json " + quote(pinched) + " --repair -o " + quote(fixed), dir);
+  REQUIRE(fs::exists(fixed));
+  json j = parse_json(r.out);
+  CHECK(j[0]["repair"]["split_vertices"].get<int>() >= 1);
+  CHECK(j[0]["nonmanifold_vertices"] == 0);
+
+  CliRun after = run_cli("check --json " + quote(fixed), dir);
+  CHECK(parse_json(after.out)[0]["nonmanifold_vertices"] == 0);
+}
+
+TEST_CASE("malformed inputs fail with one line, no output, no temp files", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_malformed");
+  const std::string out_dir = dir + "/out";
+  fs::create_directories(out_dir);
+  const TriMesh blob = spherekit::test::random_blob(1, 5);
+
+  const std::string good_ply = binary_ply(blob, blob.V.rows());
+  struct Bad {
+    std::string name, content;
+    int exit_code;
+  };
+  std::vector<Bad> cases = {
+      {"empty.obj", "", 3},
+      {"truncated.ply", good_ply.substr(0, good_ply.size() - 7 * 13 - 5), 3},
+      {"index_out_of_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 99\n", 3},
+      {"nan_coordinate.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n", 3},
+      {"mixed_faces.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nf 1 4 3 2\nf 1 2 5\nf 2 3 5\nf 3 4 5\nf 4 1 5\n", 3},
+      // The header claims one vertex more than the file holds: the faces are read one
+      // vertex record late and the data ends early.
+      {"wrong_counts.ply", binary_ply(blob, blob.V.rows() + 1), 3},
+      {"torus.obj", obj_text(spherekit::test::torus()), 3},
+      {"two_components.obj", obj_text(spherekit::test::two_tetrahedra()), 3},
+  };
+  for (const Bad& c : cases) {
+    const std::string input = dir + "/" + c.name;
+    write_text(input, c.content);
+    const std::string output = out_dir + "/" + fs::path(c.name).stem().string() + ".sphere.obj";
+    const std::string report = out_dir + "/" + fs::path(c.name).stem().string() + ".json";
+    INFO("input: " << c.name);
+
+    CliRun p = run_cli("param " + quote(input) + " -o " + quote(output) + " --report " + quote(report), dir);
+    CHECK(p.exit_code == c.exit_code);
+    require_one_line_error(p, input);
+    CHECK(files_in(out_dir).empty());
+
+    if (c.name != "torus.obj" && c.name != "two_components.obj") {
+      CliRun k = run_cli("check " + quote(input), dir);
+      CHECK(k.exit_code == c.exit_code);
+      require_one_line_error(k, input);
+    }
+  }
+
+  const std::string missing = dir + "/does_not_exist.obj";
+  CliRun m = run_cli("param " + quote(missing) + " -o " + quote(out_dir + "/m.obj"), dir);
+  CHECK(m.exit_code == 4);
+  require_one_line_error(m, missing);
+  CHECK(files_in(out_dir).empty());
+}
+
+TEST_CASE("param writes a bijective unit sphere map; eval agrees", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_param");
+  const std::string out_dir = dir + "/out";
+  fs::create_directories(out_dir);
+  const TriMesh blob = spherekit::test::random_blob(2, 11);
+  const std::string mesh = write_obj(dir, "blob.obj", blob);
+  const std::string sphere = out_dir + "/blob.sphere.obj";
+  const std::string report = out_dir + "/blob.json";
+
+  CliRun p = run_cli("param " + quote(mesh) + " -o " + quote(sphere) + " --report " + quote(report) + " --effort 1", dir);
+  INFO("stderr: " << p.err);
+  REQUIRE(p.exit_code == 0);
+  CHECK(files_in(out_dir) == std::vector<std::string>{"blob.json", "blob.sphere.obj"});
+  CHECK(p.out.find("efficiency") != std::string::npos);
+
+  const auto S = obj_vertices(sphere);
+  REQUIRE(S.size() == static_cast<size_t>(blob.V.rows()));
+  double worst = 0;
+  for (const auto& s : S) worst = std::max(worst, std::abs(s.norm() - 1.0));
+  CHECK(worst < 1e-12);
+
+  json r = parse_json(slurp(report));
+  CHECK(r["flipped_faces"] == 0);
+  CHECK(r["V"] == blob.V.rows());
+  CHECK(r["F"] == blob.F.rows());
+  CHECK(r["efficiency"].get<double>() > 0.1);
+  CHECK(r["efficiency"].get<double>() <= 1.0);
+  for (const char* key : {"input", "holes_filled", "l2_stretch", "linf_stretch", "winding", "base_vertices",
+                          "optimization_passes", "times", "cpu_seconds", "peak_rss_mb", "options", "version"})
+    CHECK(r.contains(key));
+  CHECK(r["options"]["effort"] == 1);
+
+  CliRun e = run_cli("eval --json " + quote(mesh) + " " + quote(sphere), dir);
+  REQUIRE(e.exit_code == 0);
+  json m = parse_json(e.out);
+  CHECK(m["vertices"] == blob.V.rows());
+  CHECK(m["faces"] == blob.F.rows());
+  CHECK(m["flipped"] == 0);
+  CHECK(m["flipped_exact"] == 0);
+  CHECK(m["degenerate_exact"] == 0);
+  CHECK(m["closed"] == true);
+  CHECK(m["winding"].get<double>() == Approx(1.0).margin(1e-9));
+  CHECK(m["fold_excess"].get<double>() == Approx(0.0).margin(1e-9));
+  CHECK(m["efficiency"].get<double>() == Approx(r["efficiency"].get<double>()).margin(1e-6));
+  CHECK_FALSE(m.contains("feature_err_deg"));
+
+  // --targets: vertex 0 must land where the map put it; vertex 1 on the opposite point.
+  const std::string targets = dir + "/targets.txt";
+  write_text(targets, "# name vertex x y z\nhere 0 " + std::to_string(S[0].x()) + " " + std::to_string(S[0].y()) +
+                          " " + std::to_string(S[0].z()) + "\n");
+  CliRun t = run_cli("eval --json " + quote(mesh) + " " + quote(sphere) + " --targets " + quote(targets), dir);
+  REQUIRE(t.exit_code == 0);
+  CHECK(parse_json(t.out)["feature_err_deg"].get<double>() < 1e-3);
+
+  const std::string bad_targets = dir + "/bad_targets.txt";
+  write_text(bad_targets, "nose 100000 0 0 1\n");
+  CliRun bt = run_cli("eval " + quote(mesh) + " " + quote(sphere) + " --targets " + quote(bad_targets), dir);
+  CHECK(bt.exit_code == 3);
+  require_one_line_error(bt, bad_targets);
+
+  CliRun human = run_cli("eval " + quote(mesh) + " " + quote(sphere), dir);
+  CHECK(human.exit_code == 0);
+  CHECK(human.out.find("efficiency") != std::string::npos);
+
+  // A sphere map of another mesh (different vertex count) is refused, naming the sphere file.
+  const std::string other = write_obj(dir, "other.obj", spherekit::test::icosphere(1));
+  CliRun mismatch = run_cli("eval " + quote(other) + " " + quote(sphere), dir);
+  CHECK(mismatch.exit_code == 3);
+  require_one_line_error(mismatch, sphere);
+}
+
+TEST_CASE("param on a mesh with holes maps the original vertices only", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_param_holes");
+  const TriMesh holes = spherekit::test::sphere_with_holes(2, 2);
+  const std::string mesh = write_obj(dir, "holes.obj", holes);
+  const std::string sphere = dir + "/holes.sphere.obj";
+  const std::string report = dir + "/holes.json";
+
+  CliRun p = run_cli("param " + quote(mesh) + " -o " + quote(sphere) + " --report " + quote(report) + " --quiet", dir);
+  INFO("stderr: " << p.err);
+  REQUIRE(p.exit_code == 0);
+  CHECK(p.out.empty());  // --quiet
+  CHECK(p.err.empty());
+  CHECK(obj_vertices(sphere).size() == static_cast<size_t>(holes.V.rows()));
+  CHECK(parse_json(slurp(report))["holes_filled"] == 2);
+
+  CliRun e = run_cli("eval --json " + quote(mesh) + " " + quote(sphere), dir);
+  REQUIRE(e.exit_code == 0);
+  json m = parse_json(e.out);
+  CHECK(m["closed"] == false);
+  CHECK(m["flipped"] == 0);
+  CHECK(m["flipped_exact"] == 0);
+  CHECK_FALSE(m.contains("winding"));
+}
+
+TEST_CASE("samples writes meshes and landmarks that check accepts", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_samples");
+  const std::string out = dir + "/samples";
+  CliRun r = run_cli("samples -o " + quote(out) + " --members 2 --vertices 800", dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  std::vector<std::string> objs;
+  for (const std::string& f : files_in(out))
+    if (fs::path(f).extension() == ".obj") objs.push_back(out + "/" + f);
+  REQUIRE(objs.size() == 2);
+  for (const std::string& obj : objs) {
+    const std::string stem = fs::path(obj).stem().string();
+    CHECK(fs::exists(out + "/" + stem + ".lm.txt"));
+    CliRun c = run_cli("check " + quote(obj), dir);
+    CHECK(c.exit_code == 0);
+  }
+}
+
+TEST_CASE("run maps given meshes and reports failures but keeps going", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_run");
+  const std::string good = write_obj(dir, "blob.obj", spherekit::test::random_blob(2, 4));
+  const std::string bad = write_obj(dir, "torus.obj", spherekit::test::torus());
+  const std::string out = dir + "/out";
+
+  CliRun r = run_cli("run " + quote(good) + " " + quote(bad) + " -o " + quote(out) + " --effort 0", dir);
+  INFO("stderr: " << r.err);
+  CHECK(r.exit_code == 3);
+  CHECK(r.out.find(fs::absolute(out).lexically_normal().string()) != std::string::npos);
+  CHECK(fs::exists(out + "/blob.sphere.obj"));
+  CHECK_FALSE(fs::exists(out + "/torus.sphere.obj"));
+  json report = parse_json(slurp(out + "/report.json"));
+  REQUIRE(report["meshes"].size() == 2);
+  CHECK(report["meshes"][0]["status"] == "ok");
+  CHECK(report["meshes"][0]["eval"]["flipped"] == 0);
+  CHECK(report["meshes"][0]["eval"]["winding"].get<double>() == Approx(1.0).margin(1e-9));
+  CHECK(report["meshes"][1]["status"] == "failed");
+  CHECK(report["meshes"][1]["check"]["genus"] == 1);
+  CHECK(report["summary"]["failed"] == 1);
+}
+
+TEST_CASE("run without meshes maps the built-in samples (the README's main job)", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_run_samples");
+  const std::string out = dir + "/spherekit-out";
+  CliRun r = run_cli("run -o " + quote(out), dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  json report = parse_json(slurp(out + "/report.json"));
+  REQUIRE(report["meshes"].size() >= 2);
+  for (const json& m : report["meshes"]) {
+    INFO(m.dump());
+    CHECK(m["status"] == "ok");
+    CHECK(m["eval"]["flipped"] == 0);
+    CHECK(m["eval"]["flipped_exact"] == 0);
+    CHECK(fs::exists(m["sphere_map"].get<std::string>()));
+  }
+  CHECK(fs::is_directory(out + "/input"));
+}

@@ -1,0 +1,171 @@
+#include "test_meshes.h"
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <random>
+#include <vector>
+
+namespace spherekit::test {
+namespace {
+
+TriMesh make(const std::vector<Eigen::Vector3d>& V, const std::vector<std::array<int, 3>>& F) {
+  TriMesh m;
+  m.V.resize(static_cast<Eigen::Index>(V.size()), 3);
+  for (size_t i = 0; i < V.size(); ++i) m.V.row(static_cast<Eigen::Index>(i)) = V[i].transpose();
+  m.F.resize(static_cast<Eigen::Index>(F.size()), 3);
+  for (size_t i = 0; i < F.size(); ++i)
+    for (int k = 0; k < 3; ++k) m.F(static_cast<Eigen::Index>(i), k) = F[i][k];
+  return m;
+}
+
+}  // namespace
+
+TriMesh tetrahedron() {
+  const double s = 1.0 / std::sqrt(3.0);
+  return make({{s, s, s}, {s, -s, -s}, {-s, s, -s}, {-s, -s, s}},
+              {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}});
+}
+
+TriMesh octahedron() {
+  return make({{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+              {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+}
+
+TriMesh icosphere(int level) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<Eigen::Vector3d> V = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  for (auto& v : V) v.normalize();
+  std::vector<std::array<int, 3>> F = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                       {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                       {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                       {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int l = 0; l < level; ++l) {
+    std::map<std::pair<int, int>, int> mid;
+    auto midpoint = [&](int a, int b) {
+      auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      V.push_back((V[a] + V[b]).normalized());
+      int id = static_cast<int>(V.size()) - 1;
+      mid[key] = id;
+      return id;
+    };
+    std::vector<std::array<int, 3>> G;
+    for (auto f : F) {
+      int a = midpoint(f[0], f[1]), b = midpoint(f[1], f[2]), c = midpoint(f[2], f[0]);
+      G.push_back({f[0], a, c});
+      G.push_back({f[1], b, a});
+      G.push_back({f[2], c, b});
+      G.push_back({a, b, c});
+    }
+    F = G;
+  }
+  return make(V, F);
+}
+
+TriMesh torus(int n, int m) {
+  std::vector<Eigen::Vector3d> V;
+  std::vector<std::array<int, 3>> F;
+  const double R = 1.0, r = 0.35;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      double u = 2 * M_PI * i / n, v = 2 * M_PI * j / m;
+      V.push_back({(R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)});
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      int a = i * m + j, b = ((i + 1) % n) * m + j, c = ((i + 1) % n) * m + (j + 1) % m, d = i * m + (j + 1) % m;
+      F.push_back({a, b, c});
+      F.push_back({a, c, d});
+    }
+  return make(V, F);
+}
+
+TriMesh two_tetrahedra() {
+  TriMesh a = tetrahedron();
+  TriMesh m;
+  m.V.resize(8, 3);
+  m.V.topRows(4) = a.V;
+  m.V.bottomRows(4) = a.V.rowwise() + Eigen::RowVector3d(3, 0, 0);
+  m.F.resize(8, 3);
+  m.F.topRows(4) = a.F;
+  m.F.bottomRows(4) = a.F.array() + 4;
+  return m;
+}
+
+TriMesh pinched_tetrahedra() {
+  // Two tetrahedra touching at vertex 0 (the shared apex):
+  //   first  {0,1,2,3}, second {0,4,5,6} mirrored through the apex.
+  TriMesh a = tetrahedron();
+  TriMesh m;
+  m.V.resize(7, 3);
+  m.V.topRows(4) = a.V;
+  Eigen::RowVector3d apex = a.V.row(0);
+  for (int i = 1; i < 4; ++i) m.V.row(3 + i) = 2 * apex - a.V.row(i);
+  m.F.resize(8, 3);
+  m.F.topRows(4) = a.F;
+  // Point reflection keeps orientation (det of -I is -1 in 3D, so flip each face).
+  for (int f = 0; f < 4; ++f) {
+    auto map = [](int v) { return v == 0 ? 0 : v + 3; };
+    m.F.row(4 + f) << map(a.F(f, 0)), map(a.F(f, 2)), map(a.F(f, 1));
+  }
+  return m;
+}
+
+TriMesh sphere_with_holes(int level, int holes) {
+  TriMesh s = icosphere(level);
+  // Remove the faces around up to three well-separated icosahedron vertices (ids 0, 3, 8:
+  // never adjacent), each leaving one boundary loop.
+  const int centres[3] = {0, 3, 8};
+  std::vector<char> drop(static_cast<size_t>(s.F.rows()), 0);
+  for (int h = 0; h < holes && h < 3; ++h)
+    for (Eigen::Index f = 0; f < s.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        if (s.F(f, k) == centres[h]) drop[static_cast<size_t>(f)] = 1;
+  std::vector<std::array<int, 3>> F;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f)
+    if (!drop[static_cast<size_t>(f)]) F.push_back({s.F(f, 0), s.F(f, 1), s.F(f, 2)});
+  // Drop now-unreferenced centre vertices by compaction.
+  std::vector<int> used(static_cast<size_t>(s.V.rows()), -1);
+  std::vector<Eigen::Vector3d> V;
+  for (auto& f : F)
+    for (int& v : f) {
+      if (used[static_cast<size_t>(v)] < 0) {
+        used[static_cast<size_t>(v)] = static_cast<int>(V.size());
+        V.push_back(s.V.row(v).transpose());
+      }
+      v = used[static_cast<size_t>(v)];
+    }
+  return make(V, F);
+}
+
+TriMesh random_blob(int level, std::uint64_t seed) {
+  TriMesh m = icosphere(level);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  struct Bump { Eigen::Vector3d c; double h, w; };
+  std::vector<Bump> bumps;
+  for (int i = 0; i < 6; ++i) {
+    Eigen::Vector3d c(U(rng), U(rng), U(rng));
+    if (c.norm() < 1e-3) c = Eigen::Vector3d::UnitX();
+    bumps.push_back({c.normalized(), 0.6 * (U(rng) + 1.0), 0.3 + 0.2 * (U(rng) + 1.0)});
+  }
+  Eigen::Vector3d scale(1.0 + 0.5 * (U(rng) + 1), 1.0 + 0.3 * (U(rng) + 1), 1.0);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    Eigen::Vector3d p = m.V.row(i).transpose();
+    double r = 1.0;
+    for (auto& b : bumps) r += b.h * std::exp(-(p - b.c).squaredNorm() / (b.w * b.w));
+    m.V.row(i) = (p * r).cwiseProduct(scale).transpose();
+  }
+  return m;
+}
+
+TriMesh elongated(int level, double aspect) {
+  TriMesh m = icosphere(level);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) m.V(i, 0) *= aspect;
+  return m;
+}
+
+}  // namespace spherekit::test

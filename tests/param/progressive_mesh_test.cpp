@@ -1,0 +1,123 @@
+// Progressive mesh: collapses down to a tetrahedron, exact replay, n-D coordinates.
+#include <catch2/catch.hpp>
+
+#include <map>
+#include <set>
+
+#include "detail/quadric.h"
+#include "spherekit/progressive_mesh.h"
+#include "test_meshes.h"
+
+using namespace spherekit;
+
+namespace {
+
+// Replays the collapses forward on a copy of F (independently of the library's refiner) and
+// returns the alive faces' corners at the base.
+std::vector<std::array<int, 3>> replay_forward(const ProgressiveMesh& pm, std::vector<std::array<int, 3>>& F,
+                                               std::vector<char>& alive) {
+  for (const auto& c : pm.collapses) {
+    for (int f : c.removed) alive[static_cast<size_t>(f)] = 0;
+    for (int j = c.moved_begin; j < c.moved_end; ++j)
+      for (int& v : F[static_cast<size_t>(pm.moved_faces[static_cast<size_t>(j)])])
+        if (v == c.vt) v = c.vs;
+  }
+  std::vector<std::array<int, 3>> base;
+  for (size_t f = 0; f < F.size(); ++f)
+    if (alive[f]) base.push_back(F[f]);
+  return base;
+}
+
+bool is_closed_manifold(const std::vector<std::array<int, 3>>& F) {
+  std::map<std::pair<int, int>, int> directed;
+  for (const auto& f : F)
+    for (int k = 0; k < 3; ++k) directed[{f[k], f[(k + 1) % 3]}]++;
+  for (const auto& [e, n] : directed)
+    if (n != 1 || directed.count({e.second, e.first}) != 1) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("progressive mesh of a genus-0 mesh ends in a tetrahedron and replays exactly", "[param][pm]") {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    TriMesh m = test::random_blob(2, seed);
+    RowMatXd P = m.V;
+    auto pm = build_progressive_mesh(P, m.F);
+    REQUIRE(pm.ok());
+    CHECK(pm->base_vertices.size() == 4);
+    CHECK(pm->base_faces.size() == 4);
+    CHECK(pm->collapses.size() == static_cast<size_t>(m.V.rows() - 4));
+    std::vector<std::array<int, 3>> F(static_cast<size_t>(m.F.rows()));
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f) F[static_cast<size_t>(f)] = {m.F(f, 0), m.F(f, 1), m.F(f, 2)};
+    std::vector<char> alive(F.size(), 1);
+    auto base = replay_forward(*pm, F, alive);
+    CHECK(base.size() == 4);
+    CHECK(is_closed_manifold(base));
+    // Every vertex is removed at most once and never a base vertex.
+    std::set<int> removed;
+    for (const auto& c : pm->collapses) {
+      CHECK(removed.insert(c.vt).second);
+      CHECK(c.vl != c.vr);
+    }
+    for (int v : pm->base_vertices) CHECK(removed.count(v) == 0);
+    // Undo in reverse order: restores the input faces exactly.
+    for (int i = static_cast<int>(pm->collapses.size()) - 1; i >= 0; --i) {
+      const auto& c = pm->collapses[static_cast<size_t>(i)];
+      for (int j = c.moved_begin; j < c.moved_end; ++j)
+        for (int& v : F[static_cast<size_t>(pm->moved_faces[static_cast<size_t>(j)])])
+          if (v == c.vs) v = c.vt;
+      for (int s = 0; s < 2; ++s) {
+        F[static_cast<size_t>(c.removed[static_cast<size_t>(s)])] = pm->removed_corners[2 * static_cast<size_t>(i) + static_cast<size_t>(s)];
+        alive[static_cast<size_t>(c.removed[static_cast<size_t>(s)])] = 1;
+      }
+    }
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+      CHECK(alive[static_cast<size_t>(f)]);
+      CHECK(F[static_cast<size_t>(f)] == std::array<int, 3>{m.F(f, 0), m.F(f, 1), m.F(f, 2)});
+    }
+  }
+}
+
+TEST_CASE("progressive mesh accepts 3n-dimensional coordinates and kept vertices", "[param][pm]") {
+  TriMesh a = test::random_blob(2, 7), b = test::random_blob(2, 8);  // same connectivity
+  RowMatXd P(a.V.rows(), 6);
+  P.leftCols(3) = a.V;
+  P.rightCols(3) = b.V;
+  ProgressiveMeshOptions opt;
+  opt.keep_vertices.assign(static_cast<size_t>(a.V.rows()), 0);
+  opt.keep_vertices[5] = opt.keep_vertices[17] = 1;
+  auto pm = build_progressive_mesh(P, a.F, opt);
+  REQUIRE(pm.ok());
+  CHECK(pm->base_vertices.size() == 4);
+  for (const auto& c : pm->collapses) {
+    CHECK(c.vt != 5);
+    CHECK(c.vt != 17);
+  }
+}
+
+TEST_CASE("progressive mesh refuses a torus", "[param][pm]") {
+  TriMesh t = test::torus();
+  RowMatXd P = t.V;
+  auto pm = build_progressive_mesh(P, t.F);
+  REQUIRE_FALSE(pm.ok());
+  CHECK(pm.status().code() == ErrorCode::SolverFailed);
+}
+
+TEST_CASE("n-D quadric measures squared distance to the triangle's plane", "[param][pm]") {
+  // Triangle in the plane z = 1 of R^3, weight 2: Q(x) = 2 (z - 1)^2.
+  double p0[3] = {0, 0, 1}, p1[3] = {1, 0, 1}, p2[3] = {0, 1, 1};
+  detail::QuadricND q(3);
+  q.add_triangle(p0, p1, p2, 2.0);
+  double x[3] = {5, -3, 4};
+  CHECK(q.evaluate(x) == Approx(2.0 * 9.0));
+  // In R^6 the same triangle duplicated: the 2-plane {(u, u) : u in plane}; a point (u, u + e)
+  // with e orthogonal offset has squared distance |e|^2 / 2.
+  double a0[6] = {0, 0, 1, 0, 0, 1}, a1[6] = {1, 0, 1, 1, 0, 1}, a2[6] = {0, 1, 1, 0, 1, 1};
+  detail::QuadricND q6(6);
+  q6.add_triangle(a0, a1, a2, 1.0);
+  double y[6] = {0.2, 0.3, 1, 0.2, 0.3, 1};
+  CHECK(q6.evaluate(y) == Approx(0.0).margin(1e-12));
+  double z[6] = {0.2, 0.3, 1, 0.2 + 1.0, 0.3, 1};  // offset (0,0,0,1,0,0) -> distance^2 = 1/2
+  CHECK(q6.evaluate(z) == Approx(0.5));
+}

@@ -1,0 +1,142 @@
+// Unconstrained spherical parameterization: exact answers, invariants, errors, determinism.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "spherekit/metrics.h"
+#include "spherekit/predicates.h"
+#include "spherekit/sphere_param.h"
+#include "test_meshes.h"
+
+using namespace spherekit;
+
+namespace {
+
+// Invariants every sphere map must satisfy: unit vectors, every face positively oriented by
+// the exact predicate, winding number +1.
+void require_valid_map(const TriMesh& mesh, const RowMat3d& S) {
+  REQUIRE(S.rows() == mesh.V.rows());
+  for (Eigen::Index i = 0; i < S.rows(); ++i) REQUIRE(std::abs(S.row(i).norm() - 1.0) < 1e-12);
+  REQUIRE(count_flipped_faces(mesh.F, S) == 0);
+  auto m = evaluate_sphere_map(mesh, S);
+  REQUIRE(m.ok());
+  if (m->closed) REQUIRE(std::abs(m->winding - 1.0) < 1e-9);
+}
+
+RowMat3d radial_projection(const TriMesh& m) {
+  Eigen::RowVector3d c = m.V.colwise().mean();
+  RowMat3d S = m.V.rowwise() - c;
+  S.rowwise().normalize();
+  return S;
+}
+
+}  // namespace
+
+TEST_CASE("regular tetrahedron maps to its radial projection", "[param][sphere]") {
+  TriMesh t = test::tetrahedron();
+  auto r = parameterize_sphere(t);
+  REQUIRE(r.ok());
+  require_valid_map(t, r->map.S);
+  RowMat3d expect = radial_projection(t);
+  for (int i = 0; i < 4; ++i) CHECK((r->map.S.row(i) - expect.row(i)).norm() < 1e-9);
+  CHECK(r->flipped_faces == 0);
+  CHECK(r->base_vertices == 4);
+}
+
+TEST_CASE("regular octahedron maps to its radial projection", "[param][sphere]") {
+  TriMesh o = test::octahedron();
+  SphereParamOptions opt;
+  opt.effort = 5;
+  auto r = parameterize_sphere(o, opt);
+  REQUIRE(r.ok());
+  require_valid_map(o, r->map.S);
+  // The optimum is the symmetric embedding; the line searches reach it to their tolerance.
+  RowMat3d expect = radial_projection(o);
+  for (int i = 0; i < 6; ++i) CHECK((r->map.S.row(i) - expect.row(i)).norm() < 2e-3);
+}
+
+TEST_CASE("random genus-0 meshes give bijective maps better than radial projection", "[param][sphere]") {
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    TriMesh m = test::random_blob(3, seed);
+    auto r = parameterize_sphere(m);
+    REQUIRE(r.ok());
+    require_valid_map(m, r->map.S);
+    CHECK(r->flipped_faces == 0);
+    CHECK(std::abs(r->winding - 1.0) < 1e-9);
+    // The blobs are star-shaped, so radial projection is a valid map; stretch minimization
+    // must do at least as well.
+    auto radial = evaluate_sphere_map(m, radial_projection(m));
+    REQUIRE(radial.ok());
+    CHECK(r->efficiency >= radial->efficiency - 1e-3);
+    auto measured = evaluate_sphere_map(m, r->map.S);
+    REQUIRE(measured.ok());
+    CHECK(measured->efficiency == Approx(r->efficiency).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("elongated shape: stretch optimization beats radial projection clearly", "[param][sphere]") {
+  TriMesh m = test::elongated(3, 4.0);
+  auto r = parameterize_sphere(m);
+  REQUIRE(r.ok());
+  require_valid_map(m, r->map.S);
+  auto radial = evaluate_sphere_map(m, radial_projection(m));
+  REQUIRE(radial.ok());
+  CHECK(r->efficiency > radial->efficiency + 0.05);
+}
+
+TEST_CASE("effort 0 and effort 5 both give valid maps", "[param][sphere]") {
+  TriMesh m = test::random_blob(2, 11);
+  for (int effort : {0, 5}) {
+    SphereParamOptions opt;
+    opt.effort = effort;
+    auto r = parameterize_sphere(m, opt);
+    REQUIRE(r.ok());
+    require_valid_map(m, r->map.S);
+  }
+}
+
+TEST_CASE("meshes with holes are filled and mapped over their own vertices", "[param][sphere]") {
+  TriMesh m = test::sphere_with_holes(3, 2);
+  auto r = parameterize_sphere(m);
+  REQUIRE(r.ok());
+  CHECK(r->holes_filled == 2);
+  REQUIRE(r->map.S.rows() == m.V.rows());
+  CHECK(count_flipped_faces(m.F, r->map.S) == 0);
+  CHECK(r->flipped_faces == 0);
+}
+
+TEST_CASE("non-genus-0 inputs are refused with a clear error", "[param][sphere]") {
+  auto torus = parameterize_sphere(test::torus());
+  REQUIRE_FALSE(torus.ok());
+  CHECK(torus.status().code() == ErrorCode::InvalidInput);
+  CHECK_THAT(torus.status().message(), Catch::Contains("genus"));
+  auto two = parameterize_sphere(test::two_tetrahedra());
+  REQUIRE_FALSE(two.ok());
+  CHECK(two.status().code() == ErrorCode::InvalidInput);
+  CHECK_THAT(two.status().message(), Catch::Contains("component"));
+  SphereParamOptions bad;
+  bad.effort = 9;
+  CHECK(parameterize_sphere(test::tetrahedron(), bad).status().code() == ErrorCode::InvalidArgument);
+}
+
+TEST_CASE("results are deterministic, also across thread counts", "[param][sphere]") {
+  TriMesh m = test::random_blob(4, 5);  // 2562 vertices: large enough for parallel rounds
+  SphereParamOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  auto a = parameterize_sphere(m, one);
+  auto b = parameterize_sphere(m, one);
+  auto c = parameterize_sphere(m, two);
+  REQUIRE(a.ok());
+  REQUIRE(b.ok());
+  REQUIRE(c.ok());
+  CHECK(a->map.S == b->map.S);  // bitwise equality
+  CHECK(a->map.S == c->map.S);
+}
+
+TEST_CASE("progress callback can cancel", "[param][sphere]") {
+  int calls = 0;
+  auto r = parameterize_sphere(test::random_blob(3, 2), {}, [&](const ProgressEvent&) { return ++calls < 5; });
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.status().code() == ErrorCode::Cancelled);
+}

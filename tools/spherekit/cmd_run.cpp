@@ -1,0 +1,197 @@
+// `spherekit run`: the main job. Checks, parameterizes and evaluates every input mesh (the
+// built-in samples when none is given), writes the sphere maps and one report.json into an
+// output folder, and prints a summary table. A failing mesh is reported and skipped; the
+// others still run.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "sample_collection.h"
+#include "spherekit/formats/sphere_map_io.h"
+#include "spherekit/metrics.h"
+#include "spherekit/sphere_param.h"
+#include "spherekit/version.h"
+
+namespace fs = std::filesystem;
+
+namespace spherekit::cli {
+namespace {
+
+struct RunArgs {
+  std::vector<std::string> meshes;
+  std::string output = "spherekit-out";
+  bool quiet = false;
+  SphereParamOptions options;
+};
+
+// Output name for a mesh: its stem, made unique when two inputs share one (a/x.obj, b/x.ply).
+std::string unique_stem(const std::string& path, std::set<std::string>& used) {
+  const std::string stem = file_stem(path);
+  std::string name = stem;
+  for (int k = 2; !used.insert(name).second; ++k) name = stem + "_" + std::to_string(k);
+  return name;
+}
+
+struct MeshOutcome {
+  Json json;                       // the report entry
+  std::vector<std::string> row;    // the summary-table row
+  int exit_code = 0;
+};
+
+MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string& name, const fs::path& out_dir) {
+  MeshOutcome out;
+  Stopwatch wall;
+  out.json["file"] = path;
+  out.json["name"] = name;
+  auto fail = [&](const Status& status) {
+    out.exit_code = print_error(status);
+    out.json["status"] = "failed";
+    out.json["error"] = status.message();
+    out.json["error_code"] = error_code_name(status.code());
+    out.json["times"]["wall"] = wall.seconds();
+    out.row = {name, "", "", "", "", "", "", "", strprintf("%.2f", wall.seconds()),
+               std::string("FAILED: ") + error_code_name(status.code())};
+    return out;
+  };
+
+  auto loaded = load_mesh_checked(path, /*allow_boundary=*/true, /*repair=*/false);
+  if (!loaded.ok()) {
+    // Still record what the check saw, when the file could be read at all.
+    if (auto plain = load_mesh(path); plain.ok()) out.json["check"] = mesh_check_json(path, plain->check);
+    return fail(loaded.status());
+  }
+  const LoadedMesh& m = loaded.value();
+  out.json["check"] = mesh_check_json(path, m.check);
+
+  ProgressRenderer progress(a.quiet, name);
+  Stopwatch param_time;
+  Result<SphereParamResult> result = [&] {
+    ComputeScope graceful_cancel;
+    return parameterize_sphere(m.mesh, a.options, progress.callback());
+  }();
+  progress.finish();
+  const double param_seconds = param_time.seconds();
+  if (!result.ok()) return fail(with_file(result.status(), path));
+  const SphereParamResult& r = result.value();
+  out.json["param"] = sphere_param_result_json(r);
+  if (r.flipped_faces != 0)
+    return fail(Status(ErrorCode::SolverFailed, strprintf("%s: the map has %d flipped faces (not bijective); not written",
+                                                          path.c_str(), r.flipped_faces)));
+
+  const std::string sphere_path = (out_dir / (name + ".sphere.obj")).string();
+  Stopwatch write_time;
+  if (Status s = formats::write_sphere_map(sphere_path, m.mesh, r.map); !s.ok()) return fail(s);
+  const double write_seconds = write_time.seconds();
+  out.json["sphere_map"] = sphere_path;
+
+  // Measure the written map independently of the optimizer's own bookkeeping, with the
+  // evaluator's definitions (these are the numbers to compare with evalsphere.py).
+  Stopwatch eval_time;
+  auto metrics = evaluate_sphere_map(m.mesh, r.map.S);
+  if (!metrics.ok()) return fail(with_file(metrics.status(), sphere_path));
+  const SphereMapMetrics& e = metrics.value();
+  out.json["eval"] = sphere_map_metrics_json(e, false);
+
+  out.json["status"] = "ok";
+  out.json["times"] = Json{{"read", m.read_seconds},        {"check", m.check_seconds},
+                           {"param", param_seconds},        {"write", write_seconds},
+                           {"eval", eval_time.seconds()},   {"wall", wall.seconds()}};
+  out.row = {name,
+             std::to_string(m.check.vertices),
+             std::to_string(m.check.faces),
+             std::to_string(m.check.boundary_loops),
+             strprintf("%.4f", e.efficiency),
+             strprintf("%.4g", e.linf),
+             std::to_string(e.flipped),
+             e.closed ? strprintf("%.4f", e.winding) : std::string("-"),
+             strprintf("%.2f", wall.seconds()),
+             "ok"};
+  return out;
+}
+
+int run_main_job(const RunArgs& a) {
+  Stopwatch wall;
+  const fs::path out_dir = fs::absolute(a.output).lexically_normal();
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) return print_error(Status(ErrorCode::IoError, out_dir.string() + ": cannot create folder: " + ec.message()));
+
+  std::vector<std::string> inputs = a.meshes;
+  const bool use_samples = inputs.empty();
+  if (use_samples) {
+    // Written to disk first so the job reads them like any user mesh, and so the user can
+    // look at (and rerun on) exactly what was processed.
+    const fs::path sample_dir = out_dir / "input";
+    fs::create_directories(sample_dir, ec);
+    if (ec) return print_error(Status(ErrorCode::IoError, sample_dir.string() + ": cannot create folder: " + ec.message()));
+    auto collection = samples::make_sample_collection();
+    if (!collection.ok()) return print_error(collection.status());
+    if (Status s = samples::write_sample_collection(sample_dir.string(), collection.value()); !s.ok())
+      return print_error(s);
+    for (const samples::SampleMesh& m : collection.value()) inputs.push_back((sample_dir / (m.name + ".obj")).string());
+    std::printf("Built-in samples written to %s\n", sample_dir.c_str());
+  }
+
+  Json report;
+  report["version"] = kVersion;
+  report["inputs"] = use_samples ? "built-in samples" : "command line";
+  report["output_dir"] = out_dir.string();
+  report["options"] = sphere_param_options_json(a.options);
+  report["meshes"] = Json::array();
+
+  Table table({"mesh", "V", "F", "holes", "efficiency", "Linf", "flips", "winding", "time s", "status"});
+  std::set<std::string> used;
+  int worst = 0, failed = 0;
+  for (const std::string& path : inputs) {
+    MeshOutcome one = run_one(a, path, unique_stem(path, used), out_dir);
+    if (cancel_requested()) return print_error(cancelled_status());
+    if (one.exit_code != 0) ++failed;
+    worst = worse_exit_code(worst, one.exit_code);
+    report["meshes"].push_back(std::move(one.json));
+    table.add_row(std::move(one.row));
+  }
+  report["summary"] = Json{{"meshes", inputs.size()},
+                           {"ok", static_cast<int>(inputs.size()) - failed},
+                           {"failed", failed},
+                           {"wall_seconds", wall.seconds()},
+                           {"cpu_seconds", cpu_seconds()},
+                           {"peak_rss_mb", peak_rss_mb()}};
+
+  const std::string report_path = (out_dir / "report.json").string();
+  if (Status s = write_json_atomic(report_path, report); !s.ok()) return print_error(s);
+
+  std::printf("\n");
+  table.print();
+  std::printf("\n%d of %zu meshes mapped; sphere maps and report.json in:\n%s\n", static_cast<int>(inputs.size()) - failed,
+              inputs.size(), out_dir.c_str());
+  return worst;
+}
+
+}  // namespace
+
+void register_run(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = add_command(
+      app, "run", "The main job: check, map and measure meshes (default: built-in samples)",
+      "The main job. For each MESH (default: the built-in sample collection, written first to\n"
+      "OUT/input): check it, map it bijectively onto the sphere (as `param`), write\n"
+      "OUT/<name>.sphere.obj, measure the map (as `eval`), and finally write OUT/report.json\n"
+      "(per-mesh check, measures and times) and print a summary table and the folder. A mesh that\n"
+      "fails is reported and skipped; the exit code is then that of the worst failure.",
+      "  spherekit run                              # built-in samples -> ./spherekit-out\n"
+      "  spherekit run spot.obj bunny.obj -o maps   # your meshes -> ./maps\n"
+      "  spherekit run ../shared/meshes/*.obj --effort 3");
+  cmd->add_option("MESH", args->meshes, "input meshes (default: the built-in samples)");
+  cmd->add_option("-o,--output", args->output, "output folder (created if missing)")->capture_default_str();
+  cmd->add_flag("-q,--quiet", args->quiet, "no progress output (the table is still printed)");
+  add_sphere_param_options(*cmd, args->options);
+  cmd->callback([args] { set_exit_code(run_main_job(*args)); });
+}
+
+}  // namespace spherekit::cli

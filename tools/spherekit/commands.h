@@ -1,0 +1,19 @@
+// The subcommands of `spherekit`. Each register_<cmd>() adds one CLI::App subcommand whose
+// callback parses nothing further, runs the command and records its exit code with
+// cli::set_exit_code() (see cli_common.h). main.cpp only wires them together.
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+namespace spherekit::cli {
+
+void register_check(CLI::App& app);    // cmd_check.cpp:   mesh report, pinched-vertex repair
+void register_param(CLI::App& app);    // cmd_param.cpp:   unconstrained spherical parameterization
+void register_eval(CLI::App& app);     // cmd_eval.cpp:    measures of any sphere map (= evalsphere.py)
+void register_samples(CLI::App& app);  // cmd_samples.cpp: writes the built-in sample collection
+void register_bench(CLI::App& app);    // cmd_bench.cpp:   per-mesh time/memory/efficiency vs. the reference
+void register_run(CLI::App& app);      // cmd_run.cpp:     the main job: check + param + eval + report
+
+}  // namespace spherekit::cli

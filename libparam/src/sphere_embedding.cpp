@@ -12,8 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <cstdio>
-#include <cstdlib>
 
 #include "spherekit/predicates.h"
 
@@ -132,7 +130,6 @@ class Refiner {
     for (int i = total - 1; i >= 0; --i) {
       apply_split(i);
       SPHEREKIT_RETURN_IF_ERROR(place_new_vertex(i));
-      if (getenv("SK_DEBUG")) debug_min("split", i);
       if (st_.alive_vertices >= threshold) {
         SPHEREKIT_RETURN_IF_ERROR(optimize_level());
         threshold = next_threshold(st_.alive_vertices);
@@ -153,22 +150,10 @@ class Refiner {
   }
 
  private:
-  void debug_min(const char* what, int i) {
-    double mn = 1e9; int arg = -1;
-    for (size_t f = 0; f < st_.F.size(); ++f) if (st_.face_alive[f]) {
-      auto& c = st_.F[f];
-      Eigen::Vector3d a = st_.S.row(c[0]), b = st_.S.row(c[1]), cc = st_.S.row(c[2]);
-      double d = a.dot(b.cross(cc)) / ((b-a).norm() * (cc-a).norm() * (cc-b).norm());
-      if (d < mn) { mn = d; arg = (int)f; }
-    }
-    static double last = 1e9;
-    if (mn < 0.1 * last || mn < 1e-6) { fprintf(stderr, "%s %d alive %d min quality %g face %d\n", what, i, st_.alive_vertices, mn, arg); last = mn; }
-  }
   int next_threshold(int nv) const {
     // Extra optimization at coarse levels (ratio sqrt(r) up to 1000 vertices), as the
     // reference implementation does: coarse levels decide the global layout.
-    static const bool coarse_extra = getenv("SK_COARSE") == nullptr || atoi(getenv("SK_COARSE")) != 0;
-    double r = nv <= 1000 && coarse_extra ? std::sqrt(s_.nv_ratio) : s_.nv_ratio;
+    double r = nv <= 1000 ? std::sqrt(s_.nv_ratio) : s_.nv_ratio;
     return std::max(nv + 1, static_cast<int>(std::lround(nv * r)));
   }
 
@@ -261,13 +246,6 @@ class Refiner {
       ok = kernel_chebyshev(ring_, start, &x) ||
            kernel_near_vertex(ring_, st_.S.row(pm_.collapses[static_cast<size_t>(i)].vs).transpose(), &x);
     }
-    if (!ok && getenv("SK_DEBUG")) {
-      int bad = 0;
-      for (size_t f = 0; f < st_.F.size(); ++f) if (st_.face_alive[f] && st_.F[f][0]!=vt && st_.F[f][1]!=vt && st_.F[f][2]!=vt) {
-        auto& c = st_.F[f]; if (orient3d_origin(st_.S.row(c[0]).data(), st_.S.row(c[1]).data(), st_.S.row(c[2]).data()) <= 0) ++bad; }
-      fprintf(stderr, "split %d vt %d vs %d ring %zu badfaces(other) %d alive %d\n", i, vt, pm_.collapses[i].vs, ring_.faces.size(), bad, st_.alive_vertices);
-      for (auto& rf : ring_.faces) fprintf(stderr, "  face %d a %d b %d  n.vs=%g\n", rf.f, rf.a, rf.b, rf.n.dot(st_.S.row(pm_.collapses[i].vs).transpose()));
-    }
     if (!ok)
       return Status(ErrorCode::SolverFailed,
                     "could not place vertex " + std::to_string(vt) + " inside its spherical kernel");
@@ -304,7 +282,6 @@ class Refiner {
       });
       if (rounds < 0) return Status(ErrorCode::Cancelled, "cancelled during optimization");
       ++stats_->passes;
-      if (getenv("SK_DEBUG")) debug_min("pass", stats_->passes);
       stats_->rounds += rounds;
     }
     return Status();

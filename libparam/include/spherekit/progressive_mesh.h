@@ -46,7 +46,7 @@ struct ProgressiveMeshOptions {
   int target_vertices = 4;
   /// Relative weight of the squared edge length added to the quadric cost; it breaks the
   /// ties QEM leaves in flat regions in favour of short edges (better-shaped levels).
-  double edge_length_weight = 0.05;
+  double edge_length_weight = 0.01;
 };
 
 /// Builds the progressive mesh of a closed, manifold, genus-0 triangle mesh whose vertex

@@ -25,6 +25,7 @@ struct SphereState {
   int alive_vertices = 0;
   std::vector<double> model_area;     ///< total surface area per model at the current level
   std::vector<double> area_floor;     ///< per model: minimum energy weight area of a face
+  std::vector<double> model_scale;    ///< per model: 4 pi / model_area (surface rescaled to the sphere's area)
 
   /// Recomputes model_area over the alive faces.
   void update_areas();
@@ -44,6 +45,7 @@ struct OptimizerSettings {
   /// triangles) are evaluated with Praun & Hoppe's accordion split; the final full-resolution
   /// pass sets 0 and optimizes exactly the measured chord-triangle stretch.
   double split_distance = 0.9;
+  bool newton = false;         ///< vertex moves by safeguarded Newton steps (else Brent searches)
   std::uint64_t seed = 1;
   int threads = 0;             ///< 0 = hardware concurrency
   int max_rounds = 2000;       ///< safety cap on rounds per pass

@@ -167,6 +167,7 @@ class Refiner {
     st_.face_alive.assign(static_cast<size_t>(nf), 1);
     st_.vertex_alive.assign(static_cast<size_t>(nv), 1);
     st_.face_weight = in_.face_weight.empty() ? std::vector<double>(static_cast<size_t>(nf), 1.0) : in_.face_weight;
+    st_.face_shape_weight = in_.face_shape_weight;
     st_.fixed = in_.fixed;
     // Replay the collapses forward to recover the base level's corners.
     for (const auto& c : pm_.collapses) {

@@ -25,7 +25,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // provenance so two maps can be compared for "made the same way".
 std::string options_digest(const SphereParamOptions& o) {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "reg=%.17g;hole=%.17g;seed=%llu;effort=%d;align=%d", o.regularizer_weight, o.hole_weight,
+  std::snprintf(buf, sizeof buf, "reg=%.17g;hole=%.17g;hshape=%.17g;seed=%llu;effort=%d;align=%d", o.regularizer_weight, o.hole_weight, o.hole_shape_weight,
                 static_cast<unsigned long long>(o.seed), o.effort, o.align_rotation ? 1 : 0);
   std::uint64_t h = 1469598103934665603ULL;
   for (const char* p = buf; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
@@ -74,7 +74,11 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   const TriMesh& closed = filled.mesh;
   const int nf = static_cast<int>(closed.F.rows());
   std::vector<double> face_weight(static_cast<size_t>(nf), 1.0);
-  for (int f = filled.original_faces; f < nf; ++f) face_weight[static_cast<size_t>(f)] = options.hole_weight;
+  std::vector<double> shape_weight(static_cast<size_t>(nf), 0.0);
+  for (int f = filled.original_faces; f < nf; ++f) {
+    face_weight[static_cast<size_t>(f)] = options.hole_weight;
+    shape_weight[static_cast<size_t>(f)] = options.hole_shape_weight;
+  }
 
   // 3. Normalize: centre and scale to unit bounding-box diagonal so that every tolerance in
   //    the simplifier is relative to the model (stretch efficiency is scale-invariant).
@@ -101,6 +105,7 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   in.P = &P;
   in.pm = &pm;
   in.face_weight = face_weight;
+  in.face_shape_weight = shape_weight;
   RowMat3d S;
   detail::EmbedStats stats;
   SPHEREKIT_RETURN_IF_ERROR(detail::embed_coarse_to_fine(in, settings, progress, &S, &stats));

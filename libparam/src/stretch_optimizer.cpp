@@ -39,8 +39,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Per face and model in RingScratch::surf: pv (3), pa (3), pb (3), face weight / model area,
 // area floor, then the surface edge Gram entries |d1|^2, |d2|^2, d1.d2 (d1 = pa - pv,
 // d2 = pb - pv) and the surface area: constant while v moves, so the common case needs no
-// surface arithmetic at all.
-constexpr size_t kSurfStride = 15;
+// surface arithmetic at all; last the shape-term weight (see load_ring).
+constexpr size_t kSurfStride = 16;
 
 // SplitMix64: a stateless hash, so the random direction of a vertex depends only on
 // (seed, pass, round, vertex) and never on thread scheduling.
@@ -157,6 +157,8 @@ void SphereState::update_areas() {
     if (!(a > 0)) a = 1.0;  // a fully degenerate level (cannot happen for valid input)
     area_floor[static_cast<size_t>(m)] = 1e-3 * a / std::max(1, alive);
   }
+  average_face_area.resize(model_area.size());
+  for (size_t m = 0; m < model_area.size(); ++m) average_face_area[m] = model_area[m] / std::max(1, alive);
   model_scale.resize(model_area.size());
   for (size_t m = 0; m < model_area.size(); ++m) model_scale[m] = kFourPi / model_area[m];
 }
@@ -210,6 +212,14 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring) {
       s[12] = d2.squaredNorm();
       s[13] = d1.dot(d2);
       s[14] = 0.5 * d1.cross(d2).norm();
+      // The shape term has the weight of an average face of the level, whatever the hole
+      // face's own area: a hole's filling can be as large as the model (a flat shape's
+      // back) or tiny, and its pull must not depend on that. MIPS is scale-free, so the
+      // hole may still shrink freely on the sphere.
+      s[15] = st.face_shape_weight.empty()
+                  ? 0.0
+                  : st.face_shape_weight[static_cast<size_t>(f)] * st.average_face_area[static_cast<size_t>(m)] /
+                        st.model_area[static_cast<size_t>(m)];
     }
   }
   return !faces.empty();
@@ -220,7 +230,7 @@ namespace {
 // Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, formed explicitly.
 inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                            const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
-                           double scale, double floor, double reg_weight) {
+                           double scale, double floor, double reg_weight, double weight, double shape_weight) {
   Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
   double l1sq = e1.squaredNorm();
   if (!(l1sq > 0)) return kInf;
@@ -239,7 +249,9 @@ inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
   double mn = D > 0 ? 2 * D / (T + std::sqrt(disc > 0 ? disc : 0.0)) : 0.0;
   double reg = mn > 0 ? reg_weight / (mn * mn * mn) : kInf;
   double area = 0.5 * d1.cross(d2).norm();
-  return (area + floor) * (0.5 * (a + c) + reg);
+  double e = weight * (area + floor) * (0.5 * (a + c) + reg);
+  if (shape_weight != 0) e += D > 0 ? 0.5 * shape_weight * (0.5 * T / std::sqrt(D)) : kInf;
+  return e;
 }
 
 // A large face's energy with Praun & Hoppe's split against "accordion" slivers: the vertex i
@@ -251,7 +263,7 @@ inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
 // would stay fat and cheap; for moderately large triangles it charges the bulge of the
 // spherical triangle over its chord, which steers the coarse levels to good layouts.
 inline double split_face_energy(const Eigen::Vector3d* q, const Eigen::Vector3d* p, double scale, double floor,
-                                double reg_weight) {
+                                double reg_weight, double weight, double shape_weight) {
   double L0 = (q[1] - q[2]).squaredNorm(), L1 = (q[2] - q[0]).squaredNorm(), L2 = (q[0] - q[1]).squaredNorm();
   int i = L0 >= L1 ? (L0 >= L2 ? 0 : 2) : (L1 >= L2 ? 1 : 2);
   int j = (i + 1) % 3, k = (i + 2) % 3;
@@ -267,8 +279,8 @@ inline double split_face_energy(const Eigen::Vector3d* q, const Eigen::Vector3d*
   if (!(bb > 0)) return kInf;
   double t = -A.dot(B) / bb;
   Eigen::Vector3d pm = t * p[j] + (1 - t) * p[k];
-  return chord_energy(q[i], q[j], m, p[i], p[j], pm, scale, 0.5 * floor, reg_weight) +
-         chord_energy(q[i], m, q[k], p[i], pm, p[k], scale, 0.5 * floor, reg_weight);
+  return chord_energy(q[i], q[j], m, p[i], p[j], pm, scale, 0.5 * floor, reg_weight, weight, shape_weight) +
+         chord_energy(q[i], m, q[k], p[i], pm, p[k], scale, 0.5 * floor, reg_weight, weight, shape_weight);
 }
 
 // Energy of a small face from its Gram entries, without forming the Jacobian: for the affine
@@ -291,7 +303,10 @@ inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, 
   const double g = 2 * D / (T + std::sqrt(disc > 0 ? disc : 0.0));
   if (!(g > 0)) return kInf;
   const double g3 = g * g * g;
-  return (s[14] + s[10]) * (0.5 * T + reg_weight / g3);
+  double e = s[9] * (s[14] + s[10]) * (0.5 * T + reg_weight / g3);
+  // Scale-free shape term (MIPS, (s1^2 + s2^2) / (2 s1 s2) = T / (2 sqrt D), >= 1).
+  if (s[15] != 0) e += s[15] * (0.5 * T / std::sqrt(D));
+  return e;
 }
 }  // namespace
 
@@ -313,12 +328,12 @@ double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::
       const double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
       const double scale = st.model_scale[static_cast<size_t>(m)];
       if (!large) {
-        energy += s[9] * gram_energy(e1, e2, s, scale, reg_weight);
+        energy += gram_energy(e1, e2, s, scale, reg_weight);
       } else {
         const Eigen::Vector3d q[3] = {x, rf.qa, rf.qb};
         const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
                                       Eigen::Vector3d(s[6], s[7], s[8])};
-        energy += s[9] * split_face_energy(q, p, scale, s[10], reg_weight);
+        energy += split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15]);
       }
     }
     if (!std::isfinite(energy)) return kInf;

@@ -116,7 +116,18 @@ ProgressFn ProgressRenderer::callback() {
   return [this](const ProgressEvent& event) { return on_event(event); };
 }
 
+void ProgressRenderer::draw_terminal_line() {
+  std::string text = prefix_.empty() ? std::string() : "[" + prefix_ + "] ";
+  for (size_t i = 0; i < percent_.size(); ++i)
+    text += (i ? " | " : "") + percent_[i].first + " " + std::to_string(percent_[i].second) + "%";
+  std::fprintf(stderr, "\r\033[K%s (level %d)", text.c_str(), level_);
+  std::fflush(stderr);
+  line_open_ = true;
+  stale_ = false;
+}
+
 void ProgressRenderer::finish() {
+  if (stale_) draw_terminal_line();  // show the final state, not the last throttled one
   if (line_open_) {
     std::fputc('\n', stderr);
     std::fflush(stderr);
@@ -129,27 +140,28 @@ bool ProgressRenderer::on_event(const ProgressEvent& event) {
   if (quiet_) return true;
   const double fraction = std::isfinite(event.fraction) ? std::clamp(event.fraction, 0.0, 1.0) : 0.0;
   const int percent = static_cast<int>(fraction * 100.0);
-  const bool new_stage = event.stage != stage_;
-  if (new_stage) {
-    stage_ = std::string(event.stage);
-    last_percent_ = -1;
-  }
-  const std::string label = prefix_.empty() ? stage_ : prefix_ + " " + stage_;
   if (tty_) {
+    auto it = std::find_if(percent_.begin(), percent_.end(), [&](const auto& p) { return p.first == event.stage; });
+    const bool changed = it == percent_.end() || it->second != percent;
+    if (it == percent_.end())
+      percent_.emplace_back(std::string(event.stage), percent);
+    else
+      it->second = percent;
+    level_ = event.level;
+    stale_ = stale_ || changed;
     // Redraw only when something visible changed, at most ~20 times a second: the
-    // library may call back thousands of times per level, alternating stages.
+    // library may call back thousands of times per level.
     const auto now = std::chrono::steady_clock::now();
-    if ((!new_stage && percent == last_percent_) || now - last_draw_ < std::chrono::milliseconds(50)) return true;
-    last_draw_ = now;
-    last_percent_ = percent;
-    std::fprintf(stderr, "\r\033[K[%s] %3d%% (level %d)", label.c_str(), percent, event.level);
-    std::fflush(stderr);
-    line_open_ = true;
+    if (stale_ && now - last_draw_ >= std::chrono::milliseconds(50)) {
+      last_draw_ = now;
+      draw_terminal_line();
+    }
   } else {
     const int decile = percent / 10;
-    auto [it, first_time] = last_decile_.try_emplace(stage_, decile);
+    auto [it, first_time] = last_decile_.try_emplace(std::string(event.stage), decile);
     if (!first_time && decile <= it->second) return true;
     it->second = decile;
+    const std::string label = prefix_.empty() ? it->first : prefix_ + " " + it->first;
     std::fprintf(stderr, "[%s] %3d%% (level %d)\n", label.c_str(), percent, event.level);
     std::fflush(stderr);
   }
@@ -320,7 +332,10 @@ void add_sphere_param_options(CLI::App& command, SphereParamOptions& o) {
   command.add_option("--regularizer_weight", o.regularizer_weight,
                      "weight of the term against collapsed sphere triangles (shape-defining)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
-  command.add_option("--hole_weight", o.hole_weight, "energy weight of the faces that close holes (shape-defining)")
+  command.add_option("--hole_weight", o.hole_weight, "stretch weight of the faces that close holes (shape-defining)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  command.add_option("--hole_shape_weight", o.hole_shape_weight,
+                     "weight of the shape term that keeps hole faces from becoming slivers (shape-defining)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
 }
 
@@ -331,6 +346,7 @@ Json sphere_param_options_json(const SphereParamOptions& o) {
   j["threads"] = o.threads;
   j["regularizer_weight"] = o.regularizer_weight;
   j["hole_weight"] = o.hole_weight;
+  j["hole_shape_weight"] = o.hole_shape_weight;
   return j;
 }
 

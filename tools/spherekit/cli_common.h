@@ -83,10 +83,12 @@ void set_child_pid(pid_t pid);
 // ---------------------------------------------------------------------------------------
 // Progress
 
-/// Renders ProgressEvents on stderr. On a terminal: one line rewritten in place,
-/// `[prefix stage] 45% (level N)`; otherwise (logs, CI) one line when a stage first appears
-/// and each time it passes another 10 %, so logs stay short even when stages interleave
-/// (refine/optimize alternate per level). Quiet renderers print nothing but still cancel.
+/// Renders ProgressEvents on stderr. On a terminal: one line rewritten in place with the
+/// latest percentage of every stage seen, `[prefix] simplify 100% | refine 45% | optimize 3%
+/// (level N)`, because stages interleave (an optimize pass per refine level) and showing only
+/// the latest would flicker between them. Otherwise (logs, CI): `[prefix stage] 45% (level N)`
+/// when a stage first appears and each time it passes another 10 %, so logs stay short.
+/// Quiet renderers print nothing but still cancel.
 class ProgressRenderer {
  public:
   /// `prefix` (e.g. the mesh name) is shown before the stage name.
@@ -103,14 +105,16 @@ class ProgressRenderer {
 
  private:
   bool on_event(const ProgressEvent& event);
+  void draw_terminal_line();
 
   bool quiet_;
   bool tty_;
   std::string prefix_;
-  std::string stage_;
-  int last_percent_ = -1;                   // terminal: last percent drawn for stage_
-  std::map<std::string, int> last_decile_;  // logs: last 10 % step printed, per stage
+  std::vector<std::pair<std::string, int>> percent_;  // terminal: latest percent per stage, in order seen
+  std::map<std::string, int> last_decile_;             // logs: last 10 % step printed, per stage
   bool line_open_ = false;
+  bool stale_ = false;  // terminal: a change was not drawn yet (throttled)
+  int level_ = 0;
   std::chrono::steady_clock::time_point last_draw_{};
 };
 

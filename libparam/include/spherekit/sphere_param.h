@@ -16,7 +16,10 @@ namespace spherekit {
 struct SphereParamOptions {
   // Shape-defining: changing these changes the answer (recorded in Provenance).
   double regularizer_weight = 1e-4;  ///< weight of the anti-sliver term w * min(a',c')^-3 (Praun & Hoppe 2003)
-  double hole_weight = 1e-5;         ///< energy weight of faces added to close holes
+  double hole_weight = 1e-5;         ///< stretch weight of faces added to close holes (they may shrink freely)
+  /// Weight of a scale-free shape term on hole faces: they may shrink but not turn into
+  /// slivers, which would pin the real faces along the hole's rim.
+  double hole_shape_weight = 0.3;
   std::uint64_t seed = 1;            ///< every random choice (line-search directions) derives from this
   bool align_rotation = true;        ///< rotate the result so face directions best match surface normals
   // Effort: changes only speed and accuracy.

@@ -14,6 +14,7 @@ struct EmbedInput {
   const RowMatXd* P = nullptr;          ///< #V by 3m surface positions
   const ProgressiveMesh* pm = nullptr;  ///< its progressive mesh
   std::vector<double> face_weight;      ///< energy weight per face (empty = 1)
+  std::vector<double> face_shape_weight;  ///< weight of the scale-free shape term per face (empty = 0)
   /// Sphere positions of the base vertices (#V rows, only base rows read); empty = map the
   /// base tetrahedron to a regular tetrahedron inscribed in the unit sphere.
   RowMat3d base_positions;

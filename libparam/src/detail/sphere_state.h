@@ -18,6 +18,9 @@ struct SphereState {
   std::vector<std::array<int, 3>> F;  ///< current corners of every face (ids stable)
   std::vector<char> face_alive;
   std::vector<double> face_weight;    ///< energy weight per face (hole faces: small)
+  /// Weight of the scale-free shape (MIPS) term per face; empty = 0. Hole faces carry it so
+  /// that they may shrink freely but not degenerate into slivers that pin their neighbours.
+  std::vector<double> face_shape_weight;
   std::vector<std::vector<int>> vf;   ///< alive faces around each vertex
   RowMat3d S;                         ///< sphere position of every vertex (alive ones valid)
   std::vector<char> vertex_alive;
@@ -25,6 +28,7 @@ struct SphereState {
   int alive_vertices = 0;
   std::vector<double> model_area;     ///< total surface area per model at the current level
   std::vector<double> area_floor;     ///< per model: minimum energy weight area of a face
+  std::vector<double> average_face_area;  ///< per model: model_area / alive faces
   std::vector<double> model_scale;    ///< per model: 4 pi / model_area (surface rescaled to the sphere's area)
 
   /// Recomputes model_area over the alive faces.

@@ -44,6 +44,11 @@ bool ground_truth_point(const SampleMesh& from, int v, const SampleMesh& to, Eig
 /// `<name>.template.txt` (per-vertex template points, `x y z` per line) and
 /// `<name>.corr.txt` (line k of every member's file names corresponding vertices, the
 /// format of shared/tools/evalcorr.py --corr). Files are written atomically.
+/// The .corr.txt samples are 500 Fibonacci points of the template sphere minus those in
+/// any member's hole; line k is each member's vertex with the nearest template point
+/// (so corresponding vertices agree to about half an edge length, not exactly).
+/// `dir` is created if missing. Errors: InvalidArgument (empty collection, template
+/// points not matching the vertices), IoError.
 Status write_sample_collection(const std::string& dir, const std::vector<SampleMesh>& collection);
 
 }  // namespace spherekit::samples

@@ -6,12 +6,12 @@
 //   X(u) = B(u) + sum_i L_i phi_i(|B(u) - B(c_i)|) t_i
 //
 // Limb i is a smooth bump of the body centred at template direction c_i, displaced by up
-// to L_i along its own direction t_i (the pose). phi is exp(-q^2) ("plateau": a round
-// column with a flat end, for legs, neck and snout) or exp(-q^1.5) (a tapering limb with
-// a rounded tip, for tail and ears; the Gaussian exp(-q) would end in a needle point,
-// tip radius r^2 / 2L ~ 0.01, that no mesh of this resolution can triangulate well),
-// q = |B(u) - B(c_i)|^2 / r_i^2. Bumps are measured on the body surface, so a limb's
-// footprint is round whatever the body proportions.
+// to L_i along its own direction t_i (the pose), with profile phi = exp(-q^1.5),
+// q = |B(u) - B(c_i)|^2 / r_i^2: a limb that tapers a little toward a rounded end. (The
+// Gaussian exp(-q) ends in a needle point of radius r^2 / 2L ~ 0.01 that no mesh of this
+// resolution triangulates well; exp(-q^2) gives a flat end above a wall so steep that
+// adaptive refinement keeps halving edges across it.) Bumps are measured on the body
+// surface, so a limb's footprint is round whatever the body proportions.
 //
 // Why this is an embedding (no self-intersection), so the samples are honest surfaces:
 // the ellipsoid is one; where a bump acts, the body patch is a graph over the plane
@@ -78,8 +78,8 @@ inline std::vector<TemplateLandmark> template_landmarks() {
 }
 
 /// A spherical cap of the template: the faces whose template centroid lies inside are
-/// removed to make a hole. Both caps keep clear of every landmark by at least twice
-/// their radius.
+/// removed to make a hole. Both caps keep clear of every landmark by more than 1.8 times
+/// their radius (the mouth lies 0.13 rad below the nose tip and 0.14 above the chin).
 struct Cap {
   Vec3 centre;
   double radius;  ///< radians
@@ -92,7 +92,6 @@ struct Bump {
   double inv_r2;    ///< 1 / r_i^2
   double length;    ///< L_i
   Vec3 direction;   ///< t_i, unit
-  bool plateau;
 };
 
 struct AnimalShape {
@@ -104,7 +103,7 @@ struct AnimalShape {
     Vec3 x = body;
     for (const Bump& b : bumps) {
       const double q = (body - b.base).squaredNorm() * b.inv_r2;
-      const double e = b.plateau ? q * std::sqrt(q) : q * std::sqrt(q);
+      const double e = q * std::sqrt(q);
       // exp(-40) ~ 4e-18: beyond that the bump adds nothing representable to the body.
       if (e < 40) x += b.length * std::exp(-e) * b.direction;
     }
@@ -124,8 +123,8 @@ inline AnimalShape random_animal(Rng& rng) {
   const AnimalTemplate t;
   AnimalShape s;
   s.scale = Vec3(rng.uniform(1.5, 2.0), rng.uniform(0.72, 0.85), rng.uniform(0.75, 0.9));
-  auto add = [&](const Vec3& centre, double radius, double length, const Vec3& dir, bool plateau) {
-    s.bumps.push_back({s.scale.cwiseProduct(centre), 1 / (radius * radius), length, dir.normalized(), plateau});
+  auto add = [&](const Vec3& centre, double radius, double length, const Vec3& dir) {
+    s.bumps.push_back({s.scale.cwiseProduct(centre), 1 / (radius * radius), length, dir.normalized()});
   };
   // Legs: one length and thickness per animal; each leg swings forward/back by up to 20
   // degrees and splays outward by up to 17 degrees, which keeps t . normal > 0.5.
@@ -134,21 +133,21 @@ inline AnimalShape random_animal(Rng& rng) {
     const double swing = rng.uniform(-0.35, 0.35), splay = rng.uniform(0.0, 0.3);
     const double side = t.legs[i].y() > 0 ? 1 : -1;
     add(t.legs[i], leg_radius, leg_length,
-        Vec3(std::sin(swing), side * std::sin(splay), -std::cos(swing) * std::cos(splay)), true);
+        Vec3(std::sin(swing), side * std::sin(splay), -std::cos(swing) * std::cos(splay)));
   }
   // Tail: from hanging slightly to raised high, swishing sideways.
   add(t.tail, rng.uniform(0.11, 0.15), rng.uniform(0.8, 1.4),
-      -direction(-rng.uniform(-0.2, 0.9), rng.uniform(-0.4, 0.4)), false);
-  // Neck and head (a plateau), snout on its end, ears on its top rim.
+      -direction(-rng.uniform(-0.2, 0.9), rng.uniform(-0.4, 0.4)));
+  // Neck and head, a snout on the lower half of its end, ears on its top rim.
   const double head_radius = rng.uniform(0.36, 0.44);
   const Vec3 head_dir = direction(rng.uniform(0.1, 0.8), rng.uniform(-0.35, 0.35));
-  add(t.head, head_radius, rng.uniform(0.55, 0.95), head_dir, true);
-  add(t.snout(), 0.5 * head_radius, rng.uniform(0.18, 0.32), head_dir, true);
+  add(t.head, head_radius, rng.uniform(0.55, 0.95), head_dir);
+  add(t.snout(), 0.5 * head_radius, rng.uniform(0.18, 0.32), head_dir);
   const double ear_length = rng.uniform(0.2, 0.35), ear_radius = rng.uniform(0.08, 0.1);
   const double ear_tilt = rng.uniform(-0.2, 0.5), ear_spread = rng.uniform(0.1, 0.6);
   for (int side : {+1, -1})
     add(t.ear(side), ear_radius, ear_length,
-        Vec3(-std::sin(ear_tilt), side * ear_spread, std::cos(ear_tilt)), false);
+        Vec3(-std::sin(ear_tilt), side * ear_spread, std::cos(ear_tilt)));
   return s;
 }
 

@@ -1,8 +1,9 @@
 // Internal to the sample collection: triangulations of the unit sphere (the template
 // domain) with different connectivity, and an editor that adapts one to a surface
-// X: S^2 -> R^3 by edge bisection and edge flips while every template triangle stays
-// positively oriented on the sphere (so the template triangulation stays a valid
-// tiling of S^2 and ground-truth lookups by gnomonic barycentrics stay well defined).
+// X: S^2 -> R^3 by edge bisection, edge flips and vertex smoothing while every template
+// triangle stays positively oriented on the sphere (so the template triangulation stays
+// a valid tiling of S^2 and ground-truth lookups by gnomonic barycentrics stay well
+// defined).
 //
 // Everything is deterministic: randomness comes from the portable Rng below (not from
 // <random> distributions, whose output differs between standard libraries), and no
@@ -288,39 +289,60 @@ class SurfaceMeshEditor {
 
   /// Makes template point u a vertex: the nearest corner of the triangle containing u is
   /// moved there when it is within 30% of the triangle's shortest edge (splitting would
-  /// leave a tiny edge that refinement turns into a cluster of slivers) and the move
-  /// keeps its triangles valid; otherwise the triangle is split into three. Returns the
-  /// vertex, or -1 if u is not strictly inside any triangle (then it lies on an edge or
-  /// vertex and a nearby vertex already represents it).
-  int insert_point(const Vec3& u) {
+  /// leave a tiny edge and thin triangles), is not `fixed` (an earlier landmark) and the
+  /// move keeps its triangles fat; otherwise the triangle is split into three, or, if u
+  /// lies on one of its edges, that edge is split at u. (Landmarks in the symmetry plane
+  /// of the animal lie exactly on edges between earlier ones.) Returns the vertex.
+  int insert_point(const Vec3& u, const std::vector<char>& fixed) {
     for (int f = 0; f < static_cast<int>(F_.size()); ++f) {
       const Tri t = F_[f];
-      if (sphere_orient(U_[t[0]], U_[t[1]], u) <= kMinTemplateOrient ||
-          sphere_orient(U_[t[1]], U_[t[2]], u) <= kMinTemplateOrient ||
-          sphere_orient(U_[t[2]], U_[t[0]], u) <= kMinTemplateOrient || u.dot(U_[t[0]]) <= 0)
-        continue;
+      if (u.dot(U_[t[0]]) <= 0) continue;
+      double side[3];
+      int on_edge = -1, zeros = 0;
+      for (int k = 0; k < 3; ++k) {
+        side[k] = sphere_orient(U_[t[k]], U_[t[(k + 1) % 3]], u);
+        if (std::abs(side[k]) <= kMinTemplateOrient) {
+          on_edge = k;
+          ++zeros;
+        }
+      }
+      if (std::min({side[0], side[1], side[2]}) < -kMinTemplateOrient) continue;  // outside
+      if (zeros >= 2) {  // on a corner already
+        int corner = t[0];
+        for (int v : t)
+          if ((U_[v] - u).norm() < (U_[corner] - u).norm()) corner = v;
+        return corner;
+      }
       double shortest = INFINITY;
       int nearest = t[0];
       for (int k = 0; k < 3; ++k) {
         shortest = std::min(shortest, (U_[t[k]] - U_[t[(k + 1) % 3]]).norm());
         if ((U_[t[k]] - u).norm() < (U_[nearest] - u).norm()) nearest = t[k];
       }
-      if ((U_[nearest] - u).norm() < 0.3 * shortest && move_vertex(nearest, u)) return nearest;
+      const bool pinned = nearest < static_cast<int>(fixed.size()) && fixed[nearest];
+      if (!pinned && (U_[nearest] - u).norm() < 0.3 * shortest && move_vertex(nearest, u)) return nearest;
+      if (on_edge >= 0) return split(t[on_edge], t[(on_edge + 1) % 3], u);
       const int m = add_vertex(u);
       set_face(f, {t[0], t[1], m});
       add_face({t[1], t[2], m});
       add_face({t[2], t[0], m});
       return m;
     }
-    return -1;
+    return -1;  // not reached for a closed triangulation of the sphere
   }
 
   /// Bisects edges, most important first, until there are `target` vertices. Importance
   /// is the surface edge length plus twice the largest deviation of the surface from the
-  /// straight edge at three points along it (at most the length): long edges get shorter
-  /// (uniform sampling of the final surface, so thin limbs get many more template
-  /// samples than their small template area would), and edges passing over a feature not
-  /// yet sampled are split.
+  /// straight edge at three points along it: long edges get shorter (uniform sampling of
+  /// the final surface, so thin limbs get many more template samples than their small
+  /// template area would), and edges passing over a feature not yet sampled are split.
+  ///
+  /// Which edge is bisected first is decided on the surface, but how is decided in the
+  /// template: Rivara's longest-edge bisection (an edge is bisected only when it is the
+  /// longest template edge of both its triangles; otherwise the longer edge goes first).
+  /// That bounds template angles from below (by half the initial smallest one), whereas
+  /// bisecting whatever edge the surface picks lets thin template triangles get thinner
+  /// until new vertices land on old ones.
   void refine_to(int target) {
     using Entry = std::tuple<double, int, int>;  // ties broken by vertex ids: deterministic
     std::priority_queue<Entry> queue;
@@ -328,23 +350,27 @@ class SurfaceMeshEditor {
     for (const Tri& t : F_)
       for (int k = 0; k < 3; ++k)
         if (t[k] < t[(k + 1) % 3]) push(t[k], t[(k + 1) % 3]);
+    std::vector<std::pair<int, int>> path;  // longest-edge propagation path
     while (num_vertices() < target && !queue.empty()) {
-      const auto [priority, a, b] = queue.top();
+      const auto [priority, a0, b0] = queue.top();
       queue.pop();
-      if (!face_of_.count(edge_key(a, b))) continue;  // stale: already split or flipped
-      const int c = opposite(a, b), d = opposite(b, a);
-      // In a thin template triangle whose apex sits near the middle of the edge, the
-      // midpoint would land on the apex (in the limit a duplicate vertex, and then a
-      // cascade of them): flip to the other diagonal instead and queue that.
-      const Vec3 mid = (U_[a] + U_[b]).normalized();
-      const double crowded = 0.25 * (U_[a] - U_[b]).norm();
-      if (std::min((mid - U_[c]).norm(), (mid - U_[d]).norm()) < crowded && template_flip_allowed(a, b)) {
-        flip(a, b);
-        push(c, d);
-        continue;
+      path.assign(1, {a0, b0});
+      while (!path.empty() && num_vertices() < target) {
+        const auto [a, b] = path.back();
+        if (!face_of_.count(edge_key(a, b))) {  // stale: already split
+          path.pop_back();
+          continue;
+        }
+        const int c = opposite(a, b), d = opposite(b, a);
+        const auto longer = longest_template_edge(a, b, c, d);
+        if (longer.first != a || longer.second != b) {
+          path.push_back(longer);
+          continue;
+        }
+        const int m = split(a, b);
+        for (int w : {a, b, c, d}) push(m, w);
+        path.pop_back();
       }
-      const int m = split(a, b);
-      for (int w : {a, b, c, d}) push(m, w);
     }
   }
 
@@ -493,21 +519,35 @@ class SurfaceMeshEditor {
       const Vec3 on_surface = surface_(((1 - s) * U_[a] + s * U_[b]).normalized());
       deviation = std::max(deviation, (on_surface - ((1 - s) * X_[a] + s * X_[b])).norm());
     }
-    // The deviation term is capped at the edge's own length: it exists to make a long
-    // edge passing over an unsampled feature (an ear) important, but uncapped it would
-    // keep halving edges across a limb's steep wall into a cascade of tiny ones.
-    const double length = (X_[a] - X_[b]).norm();
-    return length + 2 * std::min(deviation, length);
+    return (X_[a] - X_[b]).norm() + 2 * deviation;
+  }
+
+  // Of edge a-b and the other edges of its triangles (a,b,c) and (b,a,d), the longest in
+  // the template, as a directed pair; a-b itself on ties. Lengths are compared together
+  // with the vertex ids so the order is strict and a propagation path cannot cycle.
+  std::pair<int, int> longest_template_edge(int a, int b, int c, int d) const {
+    auto key = [&](int p, int q) { return std::make_tuple((U_[p] - U_[q]).squaredNorm(), std::min(p, q), std::max(p, q)); };
+    std::pair<int, int> best{a, b};
+    auto best_key = key(a, b);
+    for (const auto& [p, q] : {std::pair{b, c}, std::pair{c, a}, std::pair{a, d}, std::pair{d, b}}) {
+      if (key(p, q) > best_key) {
+        best = {p, q};
+        best_key = key(p, q);
+      }
+    }
+    return best;
   }
 
   // Faces (a,b,c) and (b,a,d) become (a,m,c), (m,b,c), (b,m,d), (m,a,d), with m at the
   // middle of the great arc a-b; all four are valid when the two old ones were. (On a
-  // limb's wall m may land far from the middle of the surface edge; smoothing fixes the
-  // distribution afterwards, while template bisection keeps template triangles fat.)
-  int split(int a, int b) {
+  // limb's wall m can land far from the middle of the surface edge; smoothing evens the
+  // distribution out afterwards.)
+  int split(int a, int b) { return split(a, b, (U_[a] + U_[b]).normalized()); }
+  // The same with m at template point u, which must lie on the arc a-b.
+  int split(int a, int b, const Vec3& u) {
     const int fa = face_of_.at(edge_key(a, b)), fb = face_of_.at(edge_key(b, a));
     const int c = opposite(a, b), d = opposite(b, a);
-    const int m = add_vertex((U_[a] + U_[b]).normalized());
+    const int m = add_vertex(u);
     set_face(fa, {a, m, c});
     add_face({m, b, c});
     set_face(fb, {b, m, d});

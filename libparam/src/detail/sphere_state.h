@@ -42,7 +42,9 @@ struct OptimizerSettings {
   int vsplit_vt_iter = 2;      ///< local optimizations of each inserted vertex
   int vsplit_nei_iter = 0;     ///< local optimizations of its neighbours
   int global_iter = 3;         ///< passes (rounds until no vertex is active) per level
+  int final_iter = 3;          ///< passes at full resolution (on the measured energy)
   double movetol = 1e-3;       ///< a vertex stays active while its credit exceeds this
+  double movetol_rel = 0;      ///< if > 0: threshold = min(movetol, movetol_rel * shortest chord to a neighbour)
   double nv_ratio = 1.2;       ///< a level is optimized each time #V grows by this factor
   double regularizer_weight = 1e-4;
   /// Faces whose chord plane passes closer than this to the centre (large spherical

@@ -1,0 +1,341 @@
+// Tests of geometry_image.cpp and the sphere locator: octahedral map and its folds, locator
+// against a brute-force search (both ways), resampling, the remesh's topology, and PSNR.
+#include <catch2/catch.hpp>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "spherekit/geometry_image.h"
+#include "test_meshes.h"
+
+namespace {
+
+using namespace spherekit;
+using Eigen::Vector3d;
+
+RowMat3d radial(const TriMesh& m) { return m.V.rowwise().normalized(); }
+Vector3d srow(const RowMat3d& S, int v) { return S.row(v).transpose(); }
+
+Vector3d random_direction(std::mt19937_64& rng) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  return Vector3d(N(rng), N(rng), N(rng)).normalized();
+}
+
+// Brute force: the smallest gnomonic barycentric of p in every face; returns the best face.
+int brute_force_face(const RowMat3i& F, const RowMat3d& S, const Vector3d& p, double& best_score) {
+  best_score = -1e300;
+  int best = -1;
+  for (int f = 0; f < F.rows(); ++f) {
+    Vector3d b;
+    if (!gnomonic_barycentrics(srow(S, F(f, 0)), srow(S, F(f, 1)), srow(S, F(f, 2)), p, b)) continue;
+    if (b.minCoeff() > best_score) {
+      best_score = b.minCoeff();
+      best = f;
+    }
+  }
+  return best;
+}
+
+bool bit_equal(const Vector3d& a, const Vector3d& b) { return std::memcmp(a.data(), b.data(), sizeof(double) * 3) == 0; }
+
+struct EdgeCount {
+  std::map<std::pair<int, int>, int> directed;
+  std::map<std::pair<int, int>, int> undirected;
+};
+
+EdgeCount count_edges(const TriMesh& m) {
+  EdgeCount c;
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = m.F(f, k), b = m.F(f, (k + 1) % 3);
+      ++c.directed[{a, b}];
+      ++c.undirected[{std::min(a, b), std::max(a, b)}];
+    }
+  return c;
+}
+
+double signed_volume(const TriMesh& m) {
+  double v = 0;
+  for (int f = 0; f < m.F.rows(); ++f)
+    v += Vector3d(m.V.row(m.F(f, 0))).dot(Vector3d(m.V.row(m.F(f, 1))).cross(Vector3d(m.V.row(m.F(f, 2)))));
+  return v / 6;
+}
+
+}  // namespace
+
+TEST_CASE("octahedral map: inverse round trip away from the folds", "[gim]") {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (int k = 0; k < 20000; ++k) {
+    const double u = U(rng), v = U(rng);
+    if (std::abs(std::abs(u) - 1) < 1e-9 || std::abs(std::abs(v) - 1) < 1e-9) continue;
+    const Vector3d p = octahedral_to_sphere(u, v);
+    REQUIRE(std::abs(p.norm() - 1) < 1e-15);
+    const Eigen::Vector2d uv = sphere_to_octahedral(p);
+    REQUIRE(std::abs(uv.x() - u) < 1e-12);
+    REQUIRE(std::abs(uv.y() - v) < 1e-12);
+    // Hemispheres: inner diamond = z >= 0.
+    REQUIRE((std::abs(u) + std::abs(v) <= 1) == (p.z() >= -1e-15));
+  }
+  // And the other way round, for random directions.
+  for (int k = 0; k < 20000; ++k) {
+    const Vector3d p = random_direction(rng);
+    const Eigen::Vector2d uv = sphere_to_octahedral(p);
+    REQUIRE((octahedral_to_sphere(uv.x(), uv.y()) - p).norm() < 1e-14);
+  }
+}
+
+TEST_CASE("octahedral map: the 6 octahedron vertices are texels", "[gim]") {
+  for (int n : {3, 9, 257}) {
+    const int m = n - 1, h = m / 2;
+    const auto at = [n](int i, int j) {
+      const Eigen::Vector2d uv = texel_to_octahedral(i, j, n);
+      return octahedral_to_sphere(uv.x(), uv.y());
+    };
+    CHECK(bit_equal(at(h, h), Vector3d(0, 0, 1)));
+    CHECK(bit_equal(at(h, m), Vector3d(1, 0, 0)));
+    CHECK(bit_equal(at(h, 0), Vector3d(-1, 0, 0)));
+    CHECK(bit_equal(at(m, h), Vector3d(0, 1, 0)));
+    CHECK(bit_equal(at(0, h), Vector3d(0, -1, 0)));
+    for (auto [i, j] : {std::pair{0, 0}, {0, m}, {m, 0}, {m, m}}) CHECK(bit_equal(at(i, j), Vector3d(0, 0, -1)));
+    // Octants land in the documented quadrants: inner diamond (u, v > 0) is +x+y+z, the
+    // corner triangle u, v > 0 is +x+y-z.
+    if (n >= 9) {
+      const Vector3d q = at(h + 1, h + 1);
+      CHECK((q.x() > 0 && q.y() > 0 && q.z() > 0));
+      const Vector3d c = at(m - 1, m - 1);
+      CHECK((c.x() > 0 && c.y() > 0 && c.z() < 0));
+      const Vector3d d = at(1, 1);
+      CHECK((d.x() < 0 && d.y() < 0 && d.z() < 0));
+    }
+  }
+}
+
+TEST_CASE("octahedral map: folded borders give identical sphere points", "[gim]") {
+  for (int n : {3, 5, 17, 129}) {
+    const int m = n - 1;
+    const auto at = [n](int i, int j) {
+      const Eigen::Vector2d uv = texel_to_octahedral(i, j, n);
+      return octahedral_to_sphere(uv.x(), uv.y());
+    };
+    for (int s = 0; s < n; ++s) {
+      CHECK(bit_equal(at(0, s), at(0, m - s)));
+      CHECK(bit_equal(at(m, s), at(m, m - s)));
+      CHECK(bit_equal(at(s, 0), at(m - s, 0)));
+      CHECK(bit_equal(at(s, m), at(m - s, m)));
+      CHECK(canonical_texel(0, s, n) == canonical_texel(0, m - s, n));
+      CHECK(canonical_texel(s, m, n) == canonical_texel(m - s, m, n));
+    }
+    CHECK(canonical_texel(m, m, n) == Eigen::Vector2i(0, 0));
+    CHECK(canonical_texel(m, 0, n) == Eigen::Vector2i(0, 0));
+    CHECK(canonical_texel(1, 1, n) == Eigen::Vector2i(1, 1));
+    // Distinct canonical texels are distinct sphere points.
+    std::set<std::pair<int, int>> canon;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const Eigen::Vector2i c = canonical_texel(i, j, n);
+        canon.insert({c.x(), c.y()});
+      }
+    CHECK(static_cast<int>(canon.size()) == (n - 2) * (n - 2) + 2 * n - 1);
+  }
+}
+
+TEST_CASE("geometry image sizes must be 2^k+1", "[gim]") {
+  for (int n : {3, 5, 9, 17, 33, 65, 129, 257, 513}) CHECK(is_geometry_image_size(n));
+  for (int n : {-1, 0, 1, 2, 4, 6, 10, 100, 256, 258}) CHECK_FALSE(is_geometry_image_size(n));
+  const TriMesh m = test::icosphere(1);
+  auto r = sample_geometry_image(m, radial(m), 100);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.status().code() == ErrorCode::InvalidArgument);
+  RowMat3d short_map = radial(m).topRows(5);
+  auto r2 = sample_geometry_image(m, short_map, 9);
+  REQUIRE_FALSE(r2.ok());
+  CHECK(r2.status().code() == ErrorCode::InvalidInput);
+}
+
+TEST_CASE("sphere locator agrees with a brute-force search (both ways)", "[gim]") {
+  for (int which = 0; which < 3; ++which) {
+    const TriMesh m = which == 0 ? test::icosphere(3) : which == 1 ? test::random_blob(3, 11) : test::octahedron();
+    const RowMat3d S = radial(m);
+    const SphereLocator locator(m.F, S);
+    CAPTURE(which, locator.grid_size());
+    std::mt19937_64 rng(17 + which);
+    // Way 1: random directions -> the locator's face is the brute-force best face (or ties
+    // with it on an edge) and its barycentrics reproduce the direction.
+    for (int k = 0; k < 3000; ++k) {
+      const Vector3d p = random_direction(rng);
+      const SphereLocation loc = locator.locate(p);
+      double best;
+      const int bf = brute_force_face(m.F, S, p, best);
+      REQUIRE(best > -1e-12);
+      REQUIRE(loc.inside);
+      REQUIRE(loc.face >= 0);
+      Vector3d b;
+      REQUIRE(gnomonic_barycentrics(srow(S, m.F(loc.face, 0)), srow(S, m.F(loc.face, 1)), srow(S, m.F(loc.face, 2)),
+                                    p, b));
+      if (loc.face != bf) REQUIRE(b.minCoeff() > -1e-9);  // tie on a shared edge
+      const Vector3d q = loc.bary[0] * srow(S, m.F(loc.face, 0)) + loc.bary[1] * srow(S, m.F(loc.face, 1)) +
+                         loc.bary[2] * srow(S, m.F(loc.face, 2));
+      REQUIRE((q.normalized() - p).norm() < 1e-9);
+    }
+    // Way 2: a point made from a known face and barycentrics is found in that face.
+    std::uniform_real_distribution<double> U(0.02, 1.0);
+    std::uniform_int_distribution<int> pick(0, static_cast<int>(m.F.rows()) - 1);
+    for (int k = 0; k < 3000; ++k) {
+      const int f = pick(rng);
+      Vector3d w(U(rng), U(rng), U(rng));
+      w /= w.sum();
+      const Vector3d q = w[0] * srow(S, m.F(f, 0)) + w[1] * srow(S, m.F(f, 1)) + w[2] * srow(S, m.F(f, 2));
+      const SphereLocation loc = locator.locate(q.normalized());
+      REQUIRE(loc.face == f);
+      REQUIRE((loc.bary - w).norm() < 1e-9);
+    }
+    // Vertices and edge midpoints: always found, inside.
+    for (int f = 0; f < m.F.rows(); f += 7)
+      for (int c = 0; c < 3; ++c) {
+        const Vector3d a = srow(S, m.F(f, c)), b = srow(S, m.F(f, (c + 1) % 3));
+        for (const Vector3d& p : {a, Vector3d((a + b).normalized())}) {
+          const SphereLocation loc = locator.locate(p);
+          REQUIRE(loc.inside);
+          REQUIRE(loc.bary.minCoeff() >= 0);
+          REQUIRE(std::abs(loc.bary.sum() - 1) < 1e-12);
+        }
+      }
+  }
+}
+
+TEST_CASE("sphere locator: directions in a hole get the nearest face", "[gim]") {
+  const TriMesh m = test::sphere_with_holes(3, 2);
+  const RowMat3d S = radial(m);
+  const SphereLocator locator(m.F, S);
+  std::mt19937_64 rng(5);
+  int in_holes = 0;
+  for (int k = 0; k < 4000; ++k) {
+    const Vector3d p = random_direction(rng);
+    const SphereLocation loc = locator.locate(p);
+    double best;
+    brute_force_face(m.F, S, p, best);
+    REQUIRE(loc.face >= 0);
+    if (best >= 1e-9) REQUIRE(loc.inside);
+    if (loc.inside) continue;
+    ++in_holes;
+    REQUIRE(best < 1e-6);
+    // The chosen face is the nearest (chord distance to the flat triangle) within 1e-12.
+    const auto point = [&](int f, const Vector3d& w) {
+      return Vector3d(w[0] * srow(S, m.F(f, 0)) + w[1] * srow(S, m.F(f, 1)) + w[2] * srow(S, m.F(f, 2)));
+    };
+    const double d = (point(loc.face, loc.bary) - p).norm();
+    double brute = 1e300;
+    for (int f = 0; f < m.F.rows(); ++f) {
+      // Dense barycentric grid: an upper bound on the distance to face f.
+      for (int a = 0; a <= 20; ++a)
+        for (int b = 0; a + b <= 20; ++b) brute = std::min(brute, (point(f, Vector3d(a, b, 20 - a - b) / 20) - p).norm());
+    }
+    REQUIRE(d <= brute + 1e-12);
+  }
+  CHECK(in_holes > 0);
+}
+
+TEST_CASE("geometry image of the unit icosphere lies on the unit sphere", "[gim]") {
+  const TriMesh m = test::icosphere(3);
+  // Chord error of the icosphere: the largest sagitta 1 - cos(edge/2) over its edges.
+  double sagitta = 0;
+  for (int f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Vector3d mid = (Vector3d(m.V.row(m.F(f, k))) + Vector3d(m.V.row(m.F(f, (k + 1) % 3)))) / 2;
+      sagitta = std::max(sagitta, 1 - mid.norm());
+    }
+  // A face's centre is farther in than its edges' midpoints: bound by 2x the edge sagitta.
+  auto r = sample_geometry_image(m, radial(m), 65);
+  REQUIRE(r.ok());
+  const GeometryImage& gi = r.value();
+  REQUIRE(gi.size == 65);
+  CHECK(gi.texels_in_holes == 0);
+  for (int i = 0; i < 65; ++i)
+    for (int j = 0; j < 65; ++j) {
+      const Eigen::Vector3d p = gi.position(i, j).cast<double>();
+      REQUIRE(p.norm() <= 1 + 1e-6);
+      REQUIRE(p.norm() >= 1 - 2 * sagitta);
+      // The point lies in the direction of the texel's sphere point (identity map, gnomonic).
+      const Eigen::Vector2d uv = texel_to_octahedral(i, j, 65);
+      REQUIRE((p.normalized() - octahedral_to_sphere(uv.x(), uv.y())).norm() < 1e-6);
+      REQUIRE(gi.normal(i, j).cast<double>().dot(p.normalized()) > 0.99);
+      REQUIRE(gi.face_ids[static_cast<std::size_t>(i) * 65 + j] >= 0);
+    }
+  // Folded duplicates hold identical values.
+  for (int s = 0; s < 65; ++s) {
+    CHECK(gi.position(0, s) == gi.position(0, 64 - s));
+    CHECK(gi.position(s, 64) == gi.position(64 - s, 64));
+    CHECK(gi.normal(s, 0) == gi.normal(64 - s, 0));
+  }
+}
+
+TEST_CASE("the remesh of a geometry image is a closed, consistently oriented genus-0 manifold", "[gim]") {
+  const TriMesh blob = test::random_blob(3, 5);
+  for (int n : {3, 5, 17, 65}) {
+    CAPTURE(n);
+    auto r = sample_geometry_image(blob, radial(blob), n);
+    REQUIRE(r.ok());
+    const TriMesh rm = geometry_image_mesh(r.value());
+    CHECK(rm.V.rows() == (n - 2) * (n - 2) + 2 * n - 1);
+    CHECK(rm.F.rows() == 2 * (n - 1) * (n - 1));
+    const EdgeCount e = count_edges(rm);
+    for (const auto& [edge, count] : e.undirected) REQUIRE(count == 2);
+    for (const auto& [edge, count] : e.directed) REQUIRE(count == 1);  // consistent orientation
+    for (int f = 0; f < rm.F.rows(); ++f)
+      REQUIRE((rm.F(f, 0) != rm.F(f, 1) && rm.F(f, 1) != rm.F(f, 2) && rm.F(f, 0) != rm.F(f, 2)));
+    const auto V = static_cast<long>(rm.V.rows()), E = static_cast<long>(e.undirected.size()),
+               F = static_cast<long>(rm.F.rows());
+    CHECK(V - E + F == 2);
+    CHECK(signed_volume(rm) > 0);  // outward
+    // Octahedron edges are mesh edges.
+    const int h = (n - 1) / 2;
+    if (n >= 5) {
+      // The diamond edge from +x, texel (h, n-1), to +y, texel (n-1, h), runs through texel
+      // (h+1, n-2); vertex ids follow the documented welding order.
+      std::map<std::pair<int, int>, int> id;
+      int next = 0;
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          const Eigen::Vector2i c = canonical_texel(i, j, n);
+          if (!id.count({c.x(), c.y()})) id[{c.x(), c.y()}] = next++;
+        }
+      const int a = id[{h, n - 1}], b = id[{h + 1, n - 2}];
+      CHECK(e.undirected.count({std::min(a, b), std::max(a, b)}) == 1);
+    }
+  }
+}
+
+TEST_CASE("remesh PSNR: a mesh against itself is very high and coarser images score lower", "[gim]") {
+  const TriMesh blob = test::random_blob(4, 7);
+  RemeshErrorOptions opts;
+  opts.samples = 100000;
+  const RemeshError self = remesh_error(blob, blob, opts);
+  CHECK((std::isinf(self.psnr) || self.psnr > 100));
+  CHECK(self.peak > 0);
+  double previous = 0;
+  for (int n : {33, 65, 129}) {
+    auto r = sample_geometry_image(blob, radial(blob), n);
+    REQUIRE(r.ok());
+    const double psnr = remesh_psnr(blob, geometry_image_mesh(r.value()), opts);
+    CAPTURE(n, psnr);
+    CHECK(psnr > previous);
+    CHECK(psnr < 100);
+    previous = psnr;
+  }
+  CHECK(previous > 45);
+  // Symmetric: an offset copy is measured the same either way round.
+  TriMesh shifted = blob;
+  shifted.V.col(0).array() += 0.01;
+  const RemeshError e = remesh_error(blob, shifted, opts);
+  CHECK(e.rms > 0);
+  CHECK(e.rms <= 0.01 + 1e-12);
+  CHECK(std::isfinite(e.psnr));
+}

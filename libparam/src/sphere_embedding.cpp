@@ -144,6 +144,7 @@ class Refiner {
     // Final pass at full resolution on exactly the measured energy (no accordion split).
     OptimizerSettings final_settings = s_;
     final_settings.split_distance = 0.0;
+    final_settings.global_iter = s_.final_iter;
     SPHEREKIT_RETURN_IF_ERROR(optimize_level(final_settings));
     *S = st_.S;
     return Status();

@@ -90,7 +90,8 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   // 4. Progressive mesh down to a tetrahedron.
   auto t0 = std::chrono::steady_clock::now();
   ProgressiveMeshOptions pmo;
-  pmo.face_weights = face_weight;
+  // Hole faces take full part in the simplification (only the optimizer down-weights
+  // them, as the reference does): their geometry shapes the coarse levels like any other.
   SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, closed.F, pmo, progress));
   result.times.simplify = seconds_since(t0);
   result.base_vertices = static_cast<int>(pm.base_vertices.size());

@@ -168,17 +168,20 @@ OptimizerSettings settings_for_effort(int effort) {
   // vertex moves are safeguarded Newton steps (falling back to Brent searches along random
   // great circles), which reach the same efficiency with fewer energy evaluations, and so
   // effort 2 needs two passes per level instead of three (measured on the shared dev meshes:
-  // same efficiency within 0.002, about 35% less work).
+  // same efficiency within 0.002, about 35% less work). Effort 2 also judges convergence
+  // relative to the local triangle size (movetol_rel), which spends the saved work where
+  // triangles are small on the sphere (thin limbs), at an absolute cap of 5e-4.
   OptimizerSettings s;
   s.newton = true;
   switch (std::clamp(effort, 0, 5)) {
     case 0: s.line_search_iter = 6;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 1e-2; s.nv_ratio = 1.7;  break;
     case 1: s.line_search_iter = 8;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 5e-3; s.nv_ratio = 1.25; break;
-    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 1e-3; s.nv_ratio = 1.2;  break;
+    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 5e-4; s.nv_ratio = 1.2;  s.movetol_rel = 0.03; break;
     case 3: s.line_search_iter = 40;  s.vsplit_vt_iter = 3; s.vsplit_nei_iter = 3;  s.global_iter = 5;  s.movetol = 1e-3; s.nv_ratio = 1.1;  break;
     case 4: s.line_search_iter = 100; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 5;  s.global_iter = 8;  s.movetol = 5e-4; s.nv_ratio = 1.05; break;
     default: s.line_search_iter = 200; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 20; s.global_iter = 20; s.movetol = 3e-4; s.nv_ratio = 1.04; break;
   }
+  s.final_iter = s.global_iter;
   return s;
 }
 
@@ -516,9 +519,23 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
           credit[static_cast<size_t>(w)] += 0.3 * cand[static_cast<size_t>(i)].dist / 2.0;
         }
     }
+    // Activity threshold: absolute (the reference's movetol), or relative to the vertex's
+    // shortest chord to a neighbour, so that convergence is judged at the scale of the local
+    // triangles: coarse levels stop sooner, compressed regions (thin legs) are refined longer.
+    auto tol = [&](int v) {
+      if (!(s.movetol_rel > 0)) return s.movetol;
+      double shortest = kInf;
+      const Eigen::Vector3d x = st.S.row(v).transpose();
+      for (int f : st.vf[static_cast<size_t>(v)])
+        for (int k = 0; k < 3; ++k) {
+          int w = st.F[static_cast<size_t>(f)][k];
+          if (w != v) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
+        }
+      return std::min(s.movetol, s.movetol_rel * shortest);
+    };
     next.clear();
     for (int v : active)
-      if (credit[static_cast<size_t>(v)] > s.movetol || locked[static_cast<size_t>(v)]) next.push_back(v);
+      if (locked[static_cast<size_t>(v)] || credit[static_cast<size_t>(v)] > tol(v)) next.push_back(v);
     // Neighbours of movers that were inactive may have gained enough credit.
     for (int i : order) {
       if (!cand[static_cast<size_t>(i)].moved) continue;
@@ -526,7 +543,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       for (int f : st.vf[static_cast<size_t>(v)])
         for (int k = 0; k < 3; ++k) {
           int w = st.F[static_cast<size_t>(f)][k];
-          if (w != v && credit[static_cast<size_t>(w)] > s.movetol && !(st.fixed.size() && st.fixed[static_cast<size_t>(w)]))
+          if (w != v && !(st.fixed.size() && st.fixed[static_cast<size_t>(w)]) && credit[static_cast<size_t>(w)] > tol(w))
             next.push_back(w);
         }
     }

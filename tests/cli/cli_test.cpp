@@ -295,7 +295,7 @@ TEST_CASE("malformed inputs fail with one line, no output, no temp files", "[cli
   CHECK(files_in(out_dir).empty());
 }
 
-TEST_CASE("param writes a bijective unit sphere map; eval agrees", "[cli]") {
+TEST_CASE("param writes a bijective unit sphere map and eval agrees", "[cli]") {
   const std::string dir = spherekit::test::temp_dir("cli_param");
   const std::string out_dir = dir + "/out";
   fs::create_directories(out_dir);

@@ -339,3 +339,34 @@ TEST_CASE("remesh PSNR: a mesh against itself is very high and coarser images sc
   CHECK(e.rms <= 0.01 + 1e-12);
   CHECK(std::isfinite(e.psnr));
 }
+
+TEST_CASE("geometry image of a mesh with holes: hole texels and hole faces", "[gim]") {
+  const TriMesh m = test::sphere_with_holes(3, 2);
+  auto r = sample_geometry_image(m, radial(m), 65);
+  REQUIRE(r.ok());
+  const GeometryImage& gi = r.value();
+  REQUIRE(gi.texels_in_holes > 0);
+  int count = 0;
+  for (auto h : gi.in_hole) count += h;
+  CHECK(count == gi.texels_in_holes);
+  // Every texel still has a face and lies on the (unit) mesh.
+  for (int i = 0; i < 65; ++i)
+    for (int j = 0; j < 65; ++j) REQUIRE(std::abs(gi.position(i, j).norm() - 1) < 0.05);
+  const TriMesh rm = geometry_image_mesh(gi);
+  const auto hole_faces = geometry_image_hole_faces(gi);
+  REQUIRE(hole_faces.size() == static_cast<std::size_t>(rm.F.rows()));
+  int excluded = 0;
+  for (auto h : hole_faces) excluded += h;
+  CHECK(excluded > 0);
+  CHECK(excluded < rm.F.rows() / 4);
+  RemeshErrorOptions opts;
+  opts.samples = 50000;
+  const double all = remesh_psnr(m, rm, opts), kept = remesh_psnr(m, rm, opts, hole_faces);
+  CAPTURE(all, kept);
+  CHECK(kept > all);
+  // Closed meshes have no hole faces.
+  const TriMesh ico = test::icosphere(2);
+  auto r2 = sample_geometry_image(ico, radial(ico), 17);
+  REQUIRE(r2.ok());
+  for (auto h : geometry_image_hole_faces(r2.value())) REQUIRE(h == 0);
+}

@@ -15,5 +15,6 @@ void register_eval(CLI::App& app);     // cmd_eval.cpp:    measures of any spher
 void register_samples(CLI::App& app);  // cmd_samples.cpp: writes the built-in sample collection
 void register_bench(CLI::App& app);    // cmd_bench.cpp:   per-mesh time/memory/efficiency vs. the reference
 void register_run(CLI::App& app);      // cmd_run.cpp:     the main job: check + param + eval + report
+void register_convert(CLI::App& app);  // cmd_convert.cpp: sphere map -> octahedral geometry image (EXR)
 
 }  // namespace spherekit::cli

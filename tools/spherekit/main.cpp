@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   cli::register_samples(app);
   cli::register_bench(app);
   cli::register_run(app);
+  cli::register_convert(app);
 
   try {
     // The chosen subcommand's callback runs inside parse() and records its exit code.

@@ -122,7 +122,9 @@ struct GeometryImage {
   std::vector<float> positions;  ///< N*N*3: surface point of each texel
   std::vector<float> normals;    ///< N*N*3: unit normal (area-weighted vertex normals interpolated)
   std::vector<std::int32_t> face_ids;  ///< N*N: face of the source mesh each texel fell in
-  int texels_in_holes = 0;      ///< texels whose sphere point lies in no face (nearest face used)
+  std::vector<std::uint8_t> in_hole;   ///< N*N: 1 if the texel's sphere point lies in no face
+                                       ///< (a hole of the mesh; the nearest face's value is used)
+  int texels_in_holes = 0;      ///< number of texels with in_hole == 1
 
   Eigen::Vector3f position(int i, int j) const {
     const float* p = &positions[3 * (static_cast<std::size_t>(i) * size + j)];
@@ -151,6 +153,12 @@ struct GeometryImage {
 /// a closed genus-0 manifold with 2(N-1)^2 faces. An empty/invalid image gives an empty mesh.
 TriMesh geometry_image_mesh(const GeometryImage& image);
 
+/// Per face of geometry_image_mesh(image) (same order): 1 if any of its three texels is in a
+/// hole. Such faces span (part of) a hole of the source mesh: hole texels sit at the nearest
+/// point of the nearest face, on or near the hole's rim, so these faces keep the remesh closed
+/// but are not resampled surface. Empty if image.in_hole is.
+std::vector<std::uint8_t> geometry_image_hole_faces(const GeometryImage& image);
+
 // ---------------------------------------------------------------------------------------
 // Remesh error (PSNR) — the one definition used everywhere in SphereKit
 
@@ -174,8 +182,15 @@ struct RemeshError {
 /// distance to the other mesh is exact point-to-triangle distance, found with an AABB tree.
 /// PSNR = 20 log10(bounding-box diagonal of `original` / d), d = the larger of the two
 /// one-sided RMS distances. Empty meshes give psnr = NaN.
-RemeshError remesh_error(const TriMesh& original, const TriMesh& remesh, const RemeshErrorOptions& options = {});
+///
+/// `excluded_remesh_faces` (empty, or one flag per remesh face): faces flagged 1 are left out
+/// of the remesh's surface on both sides of the measure. Pass geometry_image_hole_faces() for a
+/// source mesh with holes, so that the faces spanning the holes (which have no counterpart in
+/// the original) do not dominate the error; callers should report that they did so.
+RemeshError remesh_error(const TriMesh& original, const TriMesh& remesh, const RemeshErrorOptions& options = {},
+                         const std::vector<std::uint8_t>& excluded_remesh_faces = {});
 /// remesh_error(...).psnr.
-double remesh_psnr(const TriMesh& original, const TriMesh& remesh, const RemeshErrorOptions& options = {});
+double remesh_psnr(const TriMesh& original, const TriMesh& remesh, const RemeshErrorOptions& options = {},
+                   const std::vector<std::uint8_t>& excluded_remesh_faces = {});
 
 }  // namespace spherekit

@@ -1,0 +1,110 @@
+// End-to-end tests of `spherekit convert`: outputs and report on success; a bad --size is a
+// usage error (exit 2, one line, nothing written).
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/formats/mesh_io.h"
+#include "spherekit/formats/sphere_map_io.h"
+#include "test_meshes.h"
+#include "test_paths.h"
+
+namespace fs = std::filesystem;
+using namespace spherekit;
+
+namespace {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+CliRun run_cli(const std::string& args, const std::string& capture_dir) {
+  const std::string out = capture_dir + "/stdout.txt", err = capture_dir + "/stderr.txt";
+  const std::string cmd = quote(SPHEREKIT_EXE) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.exit_code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+// A star-shaped blob and its radial sphere map, written into `dir`.
+void write_inputs(const std::string& dir) {
+  const TriMesh blob = test::random_blob(3, 21);
+  REQUIRE(formats::write_mesh(dir + "/blob.obj", blob).ok());
+  SphereMap map;
+  map.S = blob.V.rowwise().normalized();
+  map.provenance.method = "radial";
+  REQUIRE(formats::write_sphere_map(dir + "/blob.sphere.obj", blob, map).ok());
+}
+
+}  // namespace
+
+TEST_CASE("spherekit convert writes the geometry image, remesh and report", "[convert]") {
+  const std::string dir = test::temp_dir("convert_cli_ok"), cap = test::temp_dir("convert_cli_ok_capture");
+  write_inputs(dir);
+  const CliRun r = run_cli("convert " + quote(dir + "/blob.obj") + " " + quote(dir + "/blob.sphere.obj") + " -o " +
+                               quote(dir + "/blob.exr") + " --size 33 --remesh " + quote(dir + "/blob.gim.obj") +
+                               " --report " + quote(dir + "/blob.json") + " --psnr-samples 50000",
+                           cap);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("PSNR") != std::string::npos);
+  auto gi = convert::read_geometry_image_exr(dir + "/blob.exr");
+  REQUIRE(gi.ok());
+  CHECK(gi->image.size == 33);
+  CHECK(gi->attributes.at("layout") == "octahedral");
+  auto remesh = formats::read_mesh(dir + "/blob.gim.obj");
+  REQUIRE(remesh.ok());
+  CHECK(remesh->F.rows() == 2 * 32 * 32);
+  const auto report = nlohmann::json::parse(slurp(dir + "/blob.json"));
+  CHECK(report.at("size") == 33);
+  CHECK(report.at("psnr_db").get<double>() > 30);
+  CHECK(report.at("psnr_db").get<double>() < 100);
+}
+
+TEST_CASE("spherekit convert: a bad --size is a usage error and writes nothing", "[convert]") {
+  const std::string dir = test::temp_dir("convert_cli_bad"), cap = test::temp_dir("convert_cli_bad_capture");
+  write_inputs(dir);
+  const CliRun r = run_cli("convert " + quote(dir + "/blob.obj") + " " + quote(dir + "/blob.sphere.obj") + " -o " +
+                               quote(dir + "/out.exr") + " --size 100 --report " + quote(dir + "/r.json"),
+                           cap);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.rfind("spherekit: error: ", 0) == 0);
+  CHECK(r.err.find("100") != std::string::npos);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK_FALSE(fs::exists(dir + "/out.exr"));
+  CHECK_FALSE(fs::exists(dir + "/r.json"));
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+  CHECK(files == 2);  // the two inputs only
+
+  // A sphere map that does not match the mesh: exit 3, names the file.
+  const TriMesh other = test::icosphere(1);
+  REQUIRE(formats::write_mesh(dir + "/other.obj", other).ok());
+  const CliRun r2 = run_cli("convert " + quote(dir + "/other.obj") + " " + quote(dir + "/blob.sphere.obj") + " -o " +
+                                quote(dir + "/out.exr"),
+                            cap);
+  CHECK(r2.exit_code == 3);
+  CHECK(r2.err.find("blob.sphere.obj") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir + "/out.exr"));
+}

@@ -161,6 +161,39 @@ void SphereState::update_areas() {
   for (size_t m = 0; m < model_area.size(); ++m) average_face_area[m] = model_area[m] / std::max(1, alive);
   model_scale.resize(model_area.size());
   for (size_t m = 0; m < model_area.size(); ++m) model_scale[m] = kFourPi / model_area[m];
+  update_hole_area_penalty();
+}
+
+void SphereState::update_hole_area_penalty() {
+  // The measured efficiency of a mesh with holes is normalized by the sphere (chord) area its
+  // real faces cover, E_norm = E_real * D_real: covering more of the sphere earns nothing.
+  // The plain energy E_real instead rewards real faces for eating the hole's area, which
+  // squeezes the rim circumferentially. Locally, d(E D) = D dE + E dD, so each real face also
+  // pays lambda = E / D per unit of chord area (lambda held fixed during a level).
+  hole_area_penalty = 0;
+  if (face_shape_weight.empty()) return;
+  bool holes = false;
+  for (size_t f = 0; f < F.size() && !holes; ++f) holes = face_alive[f] && face_shape_weight[f] > 0;
+  if (!holes) return;
+  double E = 0, D = 0;
+  for (size_t f = 0; f < F.size(); ++f) {
+    if (!face_alive[f] || face_shape_weight[f] > 0) continue;
+    Eigen::Vector3d q0 = S.row(F[f][0]).transpose(), q1 = S.row(F[f][1]).transpose(), q2 = S.row(F[f][2]).transpose();
+    Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
+    double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
+    double four_a2 = E11 * E22 - E12 * E12;
+    if (!(four_a2 > 0)) continue;
+    D += 0.5 * std::sqrt(four_a2);
+    for (int m = 0; m < models; ++m) {
+      Eigen::Vector3d p0 = P->row(F[f][0]).segment<3>(3 * m).transpose();
+      Eigen::Vector3d d1 = P->row(F[f][1]).segment<3>(3 * m).transpose() - p0;
+      Eigen::Vector3d d2 = P->row(F[f][2]).segment<3>(3 * m).transpose() - p0;
+      double T = (E22 * d1.squaredNorm() + E11 * d2.squaredNorm() - 2 * E12 * d1.dot(d2)) / four_a2 *
+                 model_scale[static_cast<size_t>(m)];
+      E += face_weight[f] * 0.5 * d1.cross(d2).norm() / model_area[static_cast<size_t>(m)] * 0.5 * T;
+    }
+  }
+  if (D > 0) hole_area_penalty = E / D;
 }
 
 OptimizerSettings settings_for_effort(int effort) {
@@ -201,6 +234,7 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring) {
     rf.qa = st.S.row(rf.a).transpose();
     rf.qb = st.S.row(rf.b).transpose();
     rf.n = rf.qa.cross(rf.qb);
+    rf.real = st.face_shape_weight.empty() || !(st.face_shape_weight[static_cast<size_t>(f)] > 0);
     for (int m = 0; m < st.models; ++m) {
       double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
       for (int d = 0; d < 3; ++d) {
@@ -326,7 +360,9 @@ double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::
     const double det = x.dot(rf.n);
     if (!(det > 0)) return kInf;
     // delta < split_distance, without a square root: det^2 < split^2 |e1 x e2|^2.
-    const bool large = det * det < split_distance * split_distance * e1.cross(e2).squaredNorm();
+    const double cross2 = e1.cross(e2).squaredNorm();
+    const bool large = det * det < split_distance * split_distance * cross2;
+    if (rf.real && st.hole_area_penalty > 0) energy += st.hole_area_penalty * 0.5 * std::sqrt(cross2);
     for (int m = 0; m < st.models; ++m) {
       const double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
       const double scale = st.model_scale[static_cast<size_t>(m)];

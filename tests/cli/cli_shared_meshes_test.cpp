@@ -1,8 +1,6 @@
 // `spherekit` on the developer meshes in ../shared/meshes (skipped with a message when that
 // folder is absent): check agrees with the manifest, and eval agrees with the independent
 // evaluator shared/tools/evalsphere.py.
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -13,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_runner.h"
 #include "test_paths.h"
 
 namespace fs = std::filesystem;
@@ -20,20 +19,13 @@ using nlohmann::json;
 
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+using spherekit::test::slurp;
+std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
 
 // Runs a shell command with stdout captured to `out_file` (stderr to out_file + ".err");
 // returns the exit code.
 int run(const std::string& cmd, const std::string& out_file) {
-  const int status = std::system((cmd + " </dev/null >" + quote(out_file) + " 2>" + quote(out_file + ".err")).c_str());
-  return (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
+  return spherekit::test::run_shell(cmd, out_file, out_file + ".err");
 }
 
 }  // namespace

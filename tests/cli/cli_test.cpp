@@ -1,8 +1,6 @@
 // End-to-end tests of the `spherekit` program: exit codes, one-line error messages that
 // name the file, no output (and no temporary file) left behind on failure, and valid
 // outputs on success. Inputs are generated here into per-test temporary folders.
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -17,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_runner.h"
 #include "spherekit/version.h"
 #include "test_meshes.h"
 #include "test_paths.h"
@@ -27,32 +26,14 @@ using spherekit::TriMesh;
 
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+using spherekit::test::CliRun;
+using spherekit::test::slurp;
+std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
 
 // Runs `spherekit ARGS` with stdout/stderr captured into files of `capture_dir` (never the
 // folder whose contents a test inspects).
 CliRun run_cli(const std::string& args, const std::string& capture_dir) {
-  const std::string out = capture_dir + "/stdout.txt", err = capture_dir + "/stderr.txt";
-  const std::string cmd =
-      quote(SPHEREKIT_EXE) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.exit_code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
 }
 
 void write_text(const std::string& path, const std::string& text) {

@@ -1,7 +1,5 @@
 // End-to-end tests of `spherekit convert`: outputs and report on success; a bad --size is a
 // usage error (exit 2, one line, nothing written).
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdlib>
@@ -11,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_runner.h"
 #include "spherekit/convert/geometry_image_exr.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
@@ -22,29 +21,12 @@ using namespace spherekit;
 
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::string quote(const std::string& s) { return "'" + s + "'"; }
+using spherekit::test::CliRun;
+using spherekit::test::slurp;
+std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
 
 CliRun run_cli(const std::string& args, const std::string& capture_dir) {
-  const std::string out = capture_dir + "/stdout.txt", err = capture_dir + "/stderr.txt";
-  const std::string cmd = quote(SPHEREKIT_EXE) + " " + args + " </dev/null >" + quote(out) + " 2>" + quote(err);
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.exit_code = (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
+  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
 }
 
 // A star-shaped blob and its radial sphere map, written into `dir`.

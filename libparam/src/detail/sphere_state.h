@@ -31,8 +31,11 @@ struct SphereState {
   std::vector<double> average_face_area;  ///< per model: model_area / alive faces
   std::vector<double> model_scale;    ///< per model: 4 pi / model_area (surface rescaled to the sphere's area)
 
-  /// Recomputes model_area over the alive faces.
+  double hole_area_penalty = 0;       ///< lambda per unit chord area of real faces (meshes with holes)
+
+  /// Recomputes model_area (and the derived scales and the hole-area penalty) over the alive faces.
   void update_areas();
+  void update_hole_area_penalty();
 };
 
 /// Per-effort settings of the optimizer (Praun & Hoppe 2003's schedule; the numbers are
@@ -66,6 +69,7 @@ struct RingScratch {
     Eigen::Vector3d n;       ///< qa x qb: the kernel constraint n . x > 0
     int f;                   ///< face id
     int a, b;                ///< other corner vertex ids
+    bool real;               ///< not a hole-filling face
   };
   std::vector<Face> faces;
   std::vector<double> surf;  ///< per face and model: d1 (3), d2 (3), area weight (1)

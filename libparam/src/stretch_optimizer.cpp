@@ -209,7 +209,7 @@ OptimizerSettings settings_for_effort(int effort) {
   switch (std::clamp(effort, 0, 5)) {
     case 0: s.line_search_iter = 6;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 1e-2; s.nv_ratio = 1.7;  break;
     case 1: s.line_search_iter = 8;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 5e-3; s.nv_ratio = 1.25; break;
-    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 5e-4; s.nv_ratio = 1.2;  s.movetol_rel = 0.03; break;
+    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 5e-4; s.nv_ratio = 1.2;  s.movetol_rel = 0.02; break;
     case 3: s.line_search_iter = 40;  s.vsplit_vt_iter = 3; s.vsplit_nei_iter = 3;  s.global_iter = 5;  s.movetol = 1e-3; s.nv_ratio = 1.1;  break;
     case 4: s.line_search_iter = 100; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 5;  s.global_iter = 8;  s.movetol = 5e-4; s.nv_ratio = 1.05; break;
     default: s.line_search_iter = 200; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 20; s.global_iter = 20; s.movetol = 3e-4; s.nv_ratio = 1.04; break;

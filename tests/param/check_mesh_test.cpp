@@ -3,7 +3,6 @@
 // independent checker's results) on every shared mesh.
 #include <catch2/catch.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -360,12 +359,8 @@ TEST_CASE("check_mesh matches manifest.json on every shared mesh", "[param][chec
     const TriMesh m = test::read_shared_mesh(dir + "/" + file);
     const auto& want = entry["check"];
     REQUIRE(m.F.rows() == want["F"].get<int>());
-    const auto t0 = std::chrono::steady_clock::now();
+    // (Speed is measured by `spherekit bench`, not asserted in tests.)
     const MeshCheck c = check_mesh(m);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-#ifdef NDEBUG
-    CHECK(seconds < 0.3);  // igea, 270k faces, is the largest (optimized builds only)
-#endif
     CHECK(c.vertices == want["V"].get<int>());
     CHECK(c.edges == want["edges"].get<int>());
     CHECK(c.unreferenced_vertices == want["unreferenced_vertices"].get<int>());

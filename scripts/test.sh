@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds, and runs every test (ctest, 2 jobs). CI runs this.
 #   bash scripts/test.sh
-#   bash scripts/test.sh -L cli      (extra arguments go to ctest)
+#   bash scripts/test.sh -R cli      (extra arguments go to the normal build's ctest)
+# Two builds are tested:
+#   build/       Release: every test, including the slow runs over ../shared/meshes;
+#   build-asan/  AddressSanitizer + UndefinedBehaviorSanitizer (any finding fails the test):
+#                every test except the slow whole-corpus runs, which the normal build covers.
+# SPHEREKIT_SKIP_SANITIZE=1 skips the sanitizer build (a quicker local run).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
@@ -12,7 +17,23 @@ log="$(mktemp)"
 trap 'rm -f "$log"' EXIT
 status=0
 ctest --test-dir "$root/build" --output-on-failure -j2 "$@" 2>&1 | tee "$log" || status=$?
-# Repeat ctest's verdict as the last line, so it is the first thing one sees in a long log.
 summary="$(grep -E '^[0-9]+% tests passed' "$log" | tail -1 || true)"
+
+if [[ "${SPHEREKIT_SKIP_SANITIZE:-0}" != "1" ]]; then
+  echo "test.sh: sanitizer build (ASan + UBSan)"
+  bash "$root/scripts/build.sh" --sanitize
+  asan_log="$(mktemp)"
+  trap 'rm -f "$log" "$asan_log"' EXIT
+  asan_status=0
+  # The whole-corpus CLI runs are 3-10x slower under the sanitizers; the Release build runs them.
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir "$root/build-asan" --output-on-failure -j2 \
+      -E "shared meshes|without meshes" 2>&1 | tee "$asan_log" || asan_status=$?
+  asan_summary="$(grep -E '^[0-9]+% tests passed' "$asan_log" | tail -1 || true)"
+  echo "sanitizer build: ${asan_summary:-ctest printed no summary}"
+  if [[ "$asan_status" != 0 ]]; then status="$asan_status"; fi
+fi
+
+# Repeat the normal build's verdict as the last line, so it is the first thing one sees.
 echo "${summary:-ctest printed no summary}"
 exit "$status"

@@ -425,6 +425,20 @@ TEST_CASE("run without meshes maps the built-in samples (the README's main job)"
     CHECK(m["eval"]["flipped"] == 0);
     CHECK(m["eval"]["flipped_exact"] == 0);
     CHECK(fs::exists(m["sphere_map"].get<std::string>()));
+    // The main job also builds each map's 129 x 129 geometry image and its remesh PSNR.
+    REQUIRE(m.contains("geometry_image"));
+    const json& gim = m["geometry_image"];
+    CHECK(gim["size"] == 129);
+    const std::string gim_file = gim["file"].get<std::string>();
+    CHECK(fs::path(gim_file).filename().string() == m["name"].get<std::string>() + ".gim129.exr");
+    CHECK(fs::equivalent(fs::path(gim_file).parent_path(), fs::path(out)));
+    CHECK(fs::exists(gim_file));
+    REQUIRE(gim["psnr_db"].is_number());
+    const double psnr = gim["psnr_db"].get<double>();
+    CHECK(std::isfinite(psnr));
+    CHECK(psnr > 30);
+    CHECK(gim["seconds"].get<double>() >= 0);
   }
   CHECK(fs::is_directory(out + "/input"));
+  CHECK(r.out.find("PSNR129") != std::string::npos);
 }

@@ -1,8 +1,10 @@
 // `spherekit run`: the main job. Checks, parameterizes and evaluates every input mesh (the
 // built-in samples when none is given), writes the sphere maps and one report.json into an
-// output folder, and prints a summary table. A failing mesh is reported and skipped; the
+// output folder, builds each map's 129 x 129 octahedral geometry image (as `convert`) with its
+// remesh PSNR, and prints a summary table. A failing mesh is reported and skipped; the
 // others still run.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -13,7 +15,9 @@
 #include "cli_common.h"
 #include "commands.h"
 #include "sample_collection.h"
+#include "spherekit/convert/geometry_image_exr.h"
 #include "spherekit/formats/sphere_map_io.h"
+#include "spherekit/geometry_image.h"
 #include "spherekit/metrics.h"
 #include "spherekit/sphere_param.h"
 #include "spherekit/version.h"
@@ -22,6 +26,13 @@ namespace fs = std::filesystem;
 
 namespace spherekit::cli {
 namespace {
+
+// The geometry image the main job builds per mesh (as `spherekit convert --size 129`), and
+// the PSNR sample count per direction: lower than convert's default so the job stays fast.
+constexpr int kGeometryImageSize = 129;
+constexpr int kGeometryImagePsnrSamples = 100000;
+
+Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
 struct RunArgs {
   std::vector<std::string> meshes;
@@ -55,7 +66,7 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
     out.json["error"] = status.message();
     out.json["error_code"] = error_code_name(status.code());
     out.json["times"]["wall"] = wall.seconds();
-    out.row = {name, "", "", "", "", "", "", "", strprintf("%.2f", wall.seconds()),
+    out.row = {name, "", "", "", "", "", "", "", "", strprintf("%.2f", wall.seconds()),
                std::string("FAILED: ") + error_code_name(status.code())};
     return out;
   };
@@ -97,11 +108,33 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
   if (!metrics.ok()) return fail(with_file(metrics.status(), sphere_path));
   const SphereMapMetrics& e = metrics.value();
   out.json["eval"] = sphere_map_metrics_json(e, false);
+  const double eval_seconds = eval_time.seconds();
+
+  // The octahedral geometry image of the map and its remesh PSNR, exactly as `convert` does
+  // it (faces spanning holes of the mesh are left out of the PSNR).
+  const std::string gim_path = (out_dir / (name + ".gim" + std::to_string(kGeometryImageSize) + ".exr")).string();
+  Stopwatch gim_time;
+  auto sampled = sample_geometry_image(m.mesh, r.map.S, kGeometryImageSize);
+  if (!sampled.ok()) return fail(with_file(sampled.status(), path));
+  const GeometryImage& image = sampled.value();
+  const TriMesh remesh = geometry_image_mesh(image);
+  if (Status s = convert::write_geometry_image_exr(gim_path, image, {path, sphere_path}); !s.ok()) return fail(s);
+  const bool has_holes = image.texels_in_holes > 0;
+  RemeshErrorOptions psnr_opts;
+  psnr_opts.samples = kGeometryImagePsnrSamples;
+  const RemeshError err = remesh_error(m.mesh, remesh, psnr_opts, geometry_image_hole_faces(image));
+  const double gim_seconds = gim_time.seconds();
+  out.json["geometry_image"] = Json{{"file", gim_path},
+                                    {"size", kGeometryImageSize},
+                                    {"psnr_db", number_or_null(err.psnr)},
+                                    {"psnr_excludes_hole_faces", has_holes},
+                                    {"seconds", gim_seconds}};
 
   out.json["status"] = "ok";
   out.json["times"] = Json{{"read", m.read_seconds},        {"check", m.check_seconds},
                            {"param", param_seconds},        {"write", write_seconds},
-                           {"eval", eval_time.seconds()},   {"wall", wall.seconds()}};
+                           {"eval", eval_seconds},          {"geometry_image", gim_seconds},
+                           {"wall", wall.seconds()}};
   out.row = {name,
              std::to_string(m.check.vertices),
              std::to_string(m.check.faces),
@@ -110,6 +143,7 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
              strprintf("%.4g", e.linf),
              std::to_string(e.flipped),
              e.closed ? strprintf("%.4f", e.winding) : std::string("-"),
+             strprintf("%.2f", err.psnr),
              strprintf("%.2f", wall.seconds()),
              "ok"};
   return out;
@@ -145,7 +179,7 @@ int run_main_job(const RunArgs& a) {
   report["options"] = sphere_param_options_json(a.options);
   report["meshes"] = Json::array();
 
-  Table table({"mesh", "V", "F", "holes", "efficiency", "Linf", "flips", "winding", "time s", "status"});
+  Table table({"mesh", "V", "F", "holes", "efficiency", "Linf", "flips", "winding", "PSNR129", "time s", "status"});
   std::set<std::string> used;
   int worst = 0, failed = 0;
   for (const std::string& path : inputs) {
@@ -168,8 +202,8 @@ int run_main_job(const RunArgs& a) {
 
   std::printf("\n");
   table.print();
-  std::printf("\n%d of %zu meshes mapped; sphere maps and report.json in:\n%s\n", static_cast<int>(inputs.size()) - failed,
-              inputs.size(), out_dir.c_str());
+  std::printf("\n%d of %zu meshes mapped; sphere maps, geometry images and report.json in:\n%s\n",
+              static_cast<int>(inputs.size()) - failed, inputs.size(), out_dir.c_str());
   return worst;
 }
 
@@ -181,8 +215,10 @@ void register_run(CLI::App& app) {
       app, "run", "The main job: check, map and measure meshes (default: built-in samples)",
       "The main job. For each MESH (default: the built-in sample collection, written first to\n"
       "OUT/input): check it, map it bijectively onto the sphere (as `param`), write\n"
-      "OUT/<name>.sphere.obj, measure the map (as `eval`), and finally write OUT/report.json\n"
-      "(per-mesh check, measures and times) and print a summary table and the folder. A mesh that\n"
+      "OUT/<name>.sphere.obj, measure the map (as `eval`), build its 129 x 129 octahedral\n"
+      "geometry image OUT/<name>.gim129.exr with the remesh PSNR (as `convert --size 129`,\n"
+      "100000 PSNR samples per direction), and finally write OUT/report.json (per-mesh check,\n"
+      "measures, geometry image and times) and print a summary table and the folder. A mesh that\n"
       "fails is reported and skipped; the exit code is then that of the worst failure.",
       "  spherekit run                              # built-in samples -> ./spherekit-out\n"
       "  spherekit run spot.obj bunny.obj -o maps   # your meshes -> ./maps\n"

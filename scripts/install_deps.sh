@@ -3,10 +3,12 @@
 # only for what is missing, and refreshes the package lists only then. Non-interactive.
 set -euo pipefail
 
+# OpenMesh is not used: libparam has its own half-edge code (Debian's libopenmesh-dev also
+# pulls in ~190 MB of OpenSceneGraph/GDAL dependencies).
 packages=(
   cmake g++ ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev catch2
-  libopenmesh-dev libosd-dev libopenexr-dev libtinygltf-dev libdraco-dev libstb-dev libtbb-dev
+  libosd-dev libopenexr-dev libtinygltf-dev libdraco-dev libstb-dev libtbb-dev
   python3-numpy python3-scipy
 )
 

@@ -98,9 +98,8 @@ bool kernel_chebyshev(const RingScratch& ring, const Eigen::Vector3d& start, Eig
 // inside the wedge between vl and vr is in the kernel, so probe directions around vs at
 // shrinking distances and keep the first point the exact predicate accepts.
 bool kernel_near_vertex(const RingScratch& ring, const Eigen::Vector3d& vs, Eigen::Vector3d* out) {
-  Eigen::Vector3d e1 = (std::abs(vs.x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY());
-  e1 = (e1 - vs * vs.dot(e1)).normalized();
-  Eigen::Vector3d e2 = vs.cross(e1);
+  Eigen::Vector3d e1, e2;
+  tangent_basis(vs, e1, e2);
   for (double eps = 1e-2; eps > 1e-15; eps *= 0.1)
     for (int k = 0; k < 64; ++k) {
       double t = 2 * M_PI * (k + 0.5) / 64;

@@ -53,14 +53,6 @@ std::uint64_t mix(std::uint64_t x) {
 
 double unit_random(std::uint64_t key) { return static_cast<double>(mix(key) >> 11) * 0x1.0p-53; }
 
-// An orthonormal tangent basis at unit vector x.
-void tangent_basis(const Eigen::Vector3d& x, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
-  Eigen::Vector3d a = std::abs(x.x()) < 0.6 ? Eigen::Vector3d::UnitX()
-                      : std::abs(x.y()) < 0.6 ? Eigen::Vector3d::UnitY()
-                                               : Eigen::Vector3d::UnitZ();
-  e1 = (a - x * x.dot(a)).normalized();
-  e2 = x.cross(e1);
-}
 
 // Brent's method (parabolic interpolation with golden-section fallback) on [lo, hi],
 // starting from x0 with known f(x0). Returns the best point found within `max_eval`
@@ -138,6 +130,14 @@ bool feasible_interval(const RingScratch& ring, const Eigen::Vector3d& x0, const
 
 }  // namespace
 
+void tangent_basis(const Eigen::Vector3d& x, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
+  Eigen::Vector3d a = std::abs(x.x()) < 0.6 ? Eigen::Vector3d::UnitX()
+                      : std::abs(x.y()) < 0.6 ? Eigen::Vector3d::UnitY()
+                                               : Eigen::Vector3d::UnitZ();
+  e1 = (a - x * x.dot(a)).normalized();
+  e2 = x.cross(e1);
+}
+
 void SphereState::update_areas() {
   model_area.assign(static_cast<size_t>(models), 0.0);
   for (size_t f = 0; f < F.size(); ++f) {
@@ -188,7 +188,7 @@ void SphereState::update_hole_area_penalty() {
       Eigen::Vector3d p0 = P->row(F[f][0]).segment<3>(3 * m).transpose();
       Eigen::Vector3d d1 = P->row(F[f][1]).segment<3>(3 * m).transpose() - p0;
       Eigen::Vector3d d2 = P->row(F[f][2]).segment<3>(3 * m).transpose() - p0;
-      double T = (E22 * d1.squaredNorm() + E11 * d2.squaredNorm() - 2 * E12 * d1.dot(d2)) / four_a2 *
+      double T = gram_frobenius_numerator(E11, E22, E12, d1.squaredNorm(), d2.squaredNorm(), d1.dot(d2)) / four_a2 *
                  model_scale[static_cast<size_t>(m)];
       E += face_weight[f] * 0.5 * d1.cross(d2).norm() / model_area[static_cast<size_t>(m)] * 0.5 * T;
     }
@@ -329,7 +329,7 @@ inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, 
   const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
   const double four_a2 = E11 * E22 - E12 * E12;  // (2 A_dom)^2
   if (!(four_a2 > 1e-24 * E11 * E22)) return kInf;
-  const double T = (E22 * s[11] + E11 * s[12] - 2 * E12 * s[13]) * (scale / four_a2);
+  const double T = gram_frobenius_numerator(E11, E22, E12, s[11], s[12], s[13]) * (scale / four_a2);
   // The regularizer needs the smaller stretch; the reference takes min(a, c) in a frame
   // along one edge, which depends on which corner is moving and so makes every vertex
   // optimize a slightly different function (it can stall). We use the rotation-invariant

@@ -62,6 +62,16 @@ struct OptimizerSettings {
 
 OptimizerSettings settings_for_effort(int effort);
 
+/// An orthonormal tangent basis (e1, e2) at unit vector x, with e1 x e2 = x.
+void tangent_basis(const Eigen::Vector3d& x, Eigen::Vector3d& e1, Eigen::Vector3d& e2);
+
+/// Numerator of |J|_F^2 = a + c for the affine map taking domain edges e1, e2 to surface
+/// edges d1, d2, from their Gram entries: |J|_F^2 = (E22 D11 + E11 D22 - 2 E12 D12) /
+/// (E11 E22 - E12^2), the denominator being (2 * domain area)^2.
+inline double gram_frobenius_numerator(double E11, double E22, double E12, double D11, double D22, double D12) {
+  return E22 * D11 + E11 * D22 - 2 * E12 * D12;
+}
+
 /// Scratch memory for one vertex's 1-ring (one per thread).
 struct RingScratch {
   struct Face {

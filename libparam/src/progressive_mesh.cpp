@@ -78,6 +78,11 @@ class Simplifier {
       }
     }
     alive_count_ = nv_;
+    path_nbr_.resize(static_cast<size_t>(nv_));
+    for (const auto& e : opt_.constraint_edges) {
+      path_nbr_[static_cast<size_t>(e[0])].push_back(e[1]);
+      path_nbr_[static_cast<size_t>(e[1])].push_back(e[0]);
+    }
   }
 
   Status run(ProgressiveMesh& pm, const ProgressFn& progress) {
@@ -144,11 +149,18 @@ class Simplifier {
     return q + opt_.edge_length_weight * len2 * area_[vt];
   }
 
+  // May vt collapse into vs under the path constraints?
+  bool path_allows(int vt, int vs) const {
+    const auto& pn = path_nbr_[static_cast<size_t>(vt)];
+    if (pn.empty()) return true;
+    return pn.size() == 2 && (pn[0] == vs || pn[1] == vs);
+  }
+
   void push_edge(int a, int b) {
     bool keep_a = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(a)];
     bool keep_b = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(b)];
-    if (!keep_a) heap_.push({cost(a, b), a, b, stamp_[a], stamp_[b]});
-    if (!keep_b) heap_.push({cost(b, a), b, a, stamp_[b], stamp_[a]});
+    if (!keep_a && path_allows(a, b)) heap_.push({cost(a, b), a, b, stamp_[a], stamp_[b]});
+    if (!keep_b && path_allows(b, a)) heap_.push({cost(b, a), b, a, stamp_[b], stamp_[a]});
   }
 
   void rebuild_heap() {
@@ -172,6 +184,7 @@ class Simplifier {
   }
 
   bool collapse_if_legal(int vt, int vs, bool forced, ProgressiveMesh& pm) {
+    if (!path_allows(vt, vs)) return false;
     // The two faces sharing edge (vt, vs) and their third vertices.
     int shared[2] = {-1, -1}, third[2] = {-1, -1}, ns = 0;
     for (int f : vf_[vt]) {
@@ -252,6 +265,16 @@ class Simplifier {
     vf_[vt].clear();
     vertex_alive_[vt] = 0;
     --alive_count_;
+    // Carry the path: vt's other path edge (vt, w) becomes (vs, w).
+    auto& pt = path_nbr_[static_cast<size_t>(vt)];
+    if (!pt.empty()) {
+      int w = pt[0] == vs ? pt[1] : pt[0];
+      for (int& x : path_nbr_[static_cast<size_t>(vs)])
+        if (x == vt) x = w;
+      for (int& x : path_nbr_[static_cast<size_t>(w)])
+        if (x == vt) x = vs;
+      pt.clear();
+    }
     quadric_[vs].add(quadric_[vt]);
     area_[vs] += area_[vt];
     ++stamp_[vs];
@@ -273,6 +296,7 @@ class Simplifier {
   std::vector<detail::QuadricND> quadric_;
   std::vector<double> area_;
   std::vector<int> nt_, ns_;
+  std::vector<std::vector<int>> path_nbr_;  // per vertex: its neighbours along path edges
   std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;
 };
 
@@ -289,6 +313,9 @@ Result<ProgressiveMesh> build_progressive_mesh(const RowMatXd& P, const RowMat3i
     return Status(ErrorCode::InvalidArgument, "face_weights must have one entry per face");
   if (!options.keep_vertices.empty() && options.keep_vertices.size() != static_cast<size_t>(P.rows()))
     return Status(ErrorCode::InvalidArgument, "keep_vertices must have one entry per vertex");
+  for (const auto& e : options.constraint_edges)
+    if (e[0] < 0 || e[1] < 0 || e[0] >= P.rows() || e[1] >= P.rows() || e[0] == e[1])
+      return Status(ErrorCode::InvalidArgument, "constraint edge index out of range");
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= P.rows())

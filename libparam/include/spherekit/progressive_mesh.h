@@ -42,6 +42,12 @@ struct ProgressiveMeshOptions {
   std::vector<double> face_weights;
   /// Vertices that must never be removed (feature vertices); empty = none.
   std::vector<char> keep_vertices;
+  /// Constrained simplification (Asirvatham et al. 2005 §4): the edges of a path network.
+  /// A vertex on exactly two of them (a path's interior vertex) may only collapse along one
+  /// of them into its path neighbour; a vertex on one or more than two never moves (give it
+  /// in keep_vertices too); other vertices collapse freely. The path edges are carried
+  /// through the collapses, so each path shrinks to the single edge between its features.
+  std::vector<std::array<int, 2>> constraint_edges;
   /// Stop when this many vertices remain (4 = tetrahedron; larger for constrained bases).
   int target_vertices = 4;
   /// Relative weight of the squared edge length added to the quadric cost; it breaks the

@@ -1,0 +1,81 @@
+// Constrained spherical parameterization (Asirvatham, Praun, Hoppe 2005 §4): a bijective
+// map of a genus-0 mesh onto the unit sphere in which given feature vertices land exactly on
+// given sphere points, with low stretch. The building block of consistent parameterization.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "spherekit/mesh.h"
+#include "spherekit/progress.h"
+#include "spherekit/sphere_map.h"
+#include "spherekit/sphere_param.h"
+#include "spherekit/status.h"
+
+namespace spherekit {
+
+struct ConstrainedParamOptions {
+  /// Stretch optimizer settings (shared with the unconstrained stage; align_rotation is
+  /// ignored: the targets fix the orientation).
+  SphereParamOptions sphere;
+  // Path network (§4, §4.1). Shape-defining.
+  double steiner_penalty = 2.0;     ///< cost factor of paths through edge midpoints
+  double min_angle_deg = 10.0;      ///< arcs making smaller angles are inserted last
+  double extremity_fraction = 0.25; ///< share of features linked first as extremities
+  bool sidedness = true;            ///< defer paths leaving nearby features on the wrong side
+  bool unswirl = true;              ///< detect and re-insert swirling paths
+  bool edge_flips = true;           ///< replace paths by the shorter diagonal of their quad
+};
+
+/// The path network as built, for reports and inspection (`--dump-network`).
+struct FeatureNetworkReport {
+  int paths = 0;                  ///< 3k - 6 for k features (k counts auxiliary ones too)
+  double total_length = 0;        ///< summed surface length of the paths (input units)
+  double max_ratio = 0;           ///< max over paths of length / shortest-path distance
+  int swirls_fixed = 0;           ///< unswirl operations kept
+  int edge_flips = 0;             ///< paths replaced by the other diagonal of their quad
+  int deferred = 0;               ///< candidates put at the end of the queue by a heuristic
+  int steiner_vertices = 0;       ///< edges split at their midpoint to route paths
+  int auxiliary_features = 0;     ///< extra features added (fewer than 4, or one-sided targets)
+  int attempts = 1;               ///< network variants tried (Steiner cost varied on failure)
+  int flips_after_steiner_removal = 0;  ///< input faces flipped when Steiner vertices were dropped (then untangled)
+  std::vector<std::vector<Eigen::Vector3d>> polylines;  ///< each path on the surface (input coordinates)
+  std::vector<std::array<int, 2>> arcs;  ///< each path's features (indices; auxiliary ones after the given)
+  std::vector<Eigen::Vector3d> arc_targets;  ///< sphere points of all features, given then auxiliary
+};
+
+struct ConstrainedParamTimes {
+  double check = 0, network = 0, simplify = 0, refine = 0, total = 0;
+};
+
+struct ConstrainedParamResult {
+  SphereMap map;                 ///< one unit vector per input vertex
+  int flipped_faces = 0;         ///< by the exact predicate: 0 for a bijection
+  double efficiency = 0;         ///< stretch efficiency over the input's faces (metrics.h)
+  double l2_stretch = 0, linf_stretch = 0;
+  double winding = 0;
+  double max_feature_angle = 0;  ///< max angle (radians) between a feature's image and its target
+  int holes_filled = 0;
+  FeatureNetworkReport network;
+  ConstrainedParamTimes times;
+};
+
+/// Maps a genus-0 mesh (holes allowed) onto the unit sphere so that vertex
+/// feature_vertices[i] lands on targets[i].
+/// 0 features: the unconstrained map. 1 feature: the unconstrained map rotated onto the
+/// target. 2-3 features, or targets all on one side of the sphere: auxiliary features are
+/// added where the rotated unconstrained map puts far-away vertices, so that the features
+/// triangulate the sphere; they are reported in network.auxiliary_features.
+/// @return the map, or InvalidArgument (sizes, targets not unit vectors), InvalidInput (mesh
+///         not genus 0, two features on one vertex, targets closer than 1e-7 rad),
+///         SolverFailed (the path network could not be completed), Cancelled.
+/// Deterministic for any thread count.
+Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& mesh,
+                                                               const std::vector<int>& feature_vertices,
+                                                               const std::vector<Eigen::Vector3d>& targets,
+                                                               const ConstrainedParamOptions& options = {},
+                                                               const ProgressFn& progress = {});
+
+}  // namespace spherekit

@@ -1,0 +1,510 @@
+// The constrained spherical parameterization stage (Asirvatham, Praun, Hoppe 2005 §4):
+//   check -> fill holes -> normalize -> path network (arcs on the sphere, paths on the mesh)
+//   -> progressive mesh keeping the features, collapsing path vertices only along their paths
+//   (its base is exactly the feature triangulation) -> base on the target points ->
+//   coarse-to-fine refinement with the features fixed -> Steiner vertices removed -> final
+//   pass on the input connectivity -> measure.
+#include "spherekit/constrained_param.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <Eigen/SVD>
+
+#include "detail/path_network.h"
+#include "detail/sphere_embedding.h"
+#include "spherekit/check_mesh.h"
+#include "spherekit/fill_holes.h"
+#include "spherekit/metrics.h"
+#include "spherekit/predicates.h"
+#include "spherekit/progressive_mesh.h"
+#include "spherekit/version.h"
+
+namespace spherekit {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string options_digest(const ConstrainedParamOptions& o) {
+  char buf[384];
+  const auto& s = o.sphere;
+  std::snprintf(buf, sizeof buf,
+                "reg=%.17g;hole=%.17g;hshape=%.17g;seed=%llu;effort=%d;steiner=%.17g;angle=%.17g;ext=%.17g;side=%d;"
+                "unswirl=%d;flips=%d",
+                s.regularizer_weight, s.hole_weight, s.hole_shape_weight, static_cast<unsigned long long>(s.seed),
+                s.effort, o.steiner_penalty, o.min_angle_deg, o.extremity_fraction, o.sidedness ? 1 : 0,
+                o.unswirl ? 1 : 0, o.edge_flips ? 1 : 0);
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const char* p = buf; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+// Rotation R minimizing sum |R a_i - b_i|^2 (orthogonal Procrustes / Kabsch).
+Eigen::Matrix3d best_rotation(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
+  if (a.size() == 1) {
+    // The smallest rotation taking a to b.
+    Eigen::Vector3d axis = a[0].cross(b[0]);
+    double s = axis.norm(), c = a[0].dot(b[0]);
+    if (!(s > 1e-15)) {
+      if (c > 0) return Eigen::Matrix3d::Identity();
+      Eigen::Vector3d o = std::abs(a[0].x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+      axis = (o - o.dot(a[0]) * a[0]).normalized();
+      return Eigen::AngleAxisd(M_PI, axis).toRotationMatrix();
+    }
+    return Eigen::AngleAxisd(std::atan2(s, c), axis / s).toRotationMatrix();
+  }
+  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < a.size(); ++i) M += b[i] * a[i].transpose();
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
+  return svd.matrixU() * D * svd.matrixV().transpose();
+}
+
+double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+// Final optimization of a complete mesh whose map is already valid, features fixed: the
+// coarse-to-fine machinery on a progressive mesh without collapses runs just its final pass.
+Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector<double>& face_weight,
+                         const std::vector<double>& shape_weight, const std::vector<char>& fixed,
+                         const detail::OptimizerSettings& settings, const ProgressFn& progress, RowMat3d* S) {
+  ProgressiveMesh pm;
+  pm.num_vertices = static_cast<int>(P.rows());
+  pm.F = F;
+  for (int v = 0; v < pm.num_vertices; ++v) pm.base_vertices.push_back(v);
+  for (int f = 0; f < F.rows(); ++f) pm.base_faces.push_back(f);
+  detail::EmbedInput in;
+  in.P = &P;
+  in.pm = &pm;
+  in.face_weight = face_weight;
+  in.face_shape_weight = shape_weight;
+  in.base_positions = *S;
+  in.fixed = fixed;
+  return detail::embed_coarse_to_fine(in, settings, progress, S, nullptr);
+}
+
+// Spherical Chebyshev centre of v's kernel (maximize min over ring faces of n_f . x, with
+// n_f = S_a x S_b for ring face (v, a, b)) by projected subgradient ascent; true if the point
+// found makes every ring face positive by the exact predicate.
+bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring, const Eigen::Vector3d& start,
+                  Eigen::Vector3d* out) {
+  std::vector<Eigen::Vector3d> nrm;
+  for (const auto& r : ring) {
+    Eigen::Vector3d n = S.row(r[0]).transpose().cross(S.row(r[1]).transpose());
+    double l = n.norm();
+    if (l > 0) nrm.push_back(n / l);
+  }
+  auto valid = [&](const Eigen::Vector3d& x) {
+    for (const auto& r : ring)
+      if (orient3d_origin(x.data(), S.row(r[0]).data(), S.row(r[1]).data()) <= 0) return false;
+    return true;
+  };
+  Eigen::Vector3d x = start.normalized();
+  double step = 0.1;
+  for (int it = 0; it < 2000; ++it) {
+    double best = 1e300;
+    size_t arg = 0;
+    for (size_t k = 0; k < nrm.size(); ++k) {
+      double d = nrm[k].dot(x);
+      if (d < best) {
+        best = d;
+        arg = k;
+      }
+    }
+    if (best > 0 && valid(x)) {
+      // Keep climbing a little while it stays valid: a central point survives later moves.
+      Eigen::Vector3d y = (x + 0.5 * step * nrm[arg]).normalized();
+      *out = valid(y) ? y : x;
+      return true;
+    }
+    x = (x + step * nrm[arg]).normalized();
+    step *= 0.995;
+  }
+  return false;
+}
+
+// A mutable face set with vertex-face incidence, for undoing the network's edge splits.
+struct FaceSet {
+  std::vector<std::array<int, 3>> F;
+  std::vector<char> alive;
+  std::vector<std::vector<int>> vf;
+  void detach(int f) {
+    for (int v : F[static_cast<size_t>(f)]) {
+      auto& l = vf[static_cast<size_t>(v)];
+      l.erase(std::find(l.begin(), l.end(), f));
+    }
+  }
+  void attach(int f) {
+    for (int v : F[static_cast<size_t>(f)]) vf[static_cast<size_t>(v)].push_back(f);
+  }
+  bool flipped(const RowMat3d& S, int f) const {
+    const auto& c = F[static_cast<size_t>(f)];
+    return orient3d_origin(S.row(c[0]).data(), S.row(c[1]).data(), S.row(c[2]).data()) <= 0;
+  }
+};
+
+// Local untangling: moves the free corners of the given flipped faces (and, when that is not
+// enough, vertices in growing rings around them) to points inside their spherical kernels.
+// Returns true when no face around them is flipped any more.
+bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int> bad, RowMat3d* S) {
+  for (int sweep = 0; sweep < 120 && !bad.empty(); ++sweep) {
+    std::vector<int> cand;
+    for (int f : bad)
+      for (int v : fs.F[static_cast<size_t>(f)]) cand.push_back(v);
+    for (int grow = 0; grow < sweep / 6; ++grow) {
+      std::vector<int> more = cand;
+      for (int v : cand)
+        for (int f : fs.vf[static_cast<size_t>(v)])
+          for (int w : fs.F[static_cast<size_t>(f)]) more.push_back(w);
+      cand.swap(more);
+      std::sort(cand.begin(), cand.end());
+      cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    }
+    std::sort(cand.begin(), cand.end());
+    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+    for (int v : cand) {
+      if (fixed[static_cast<size_t>(v)]) continue;
+      std::vector<std::array<int, 2>> ring;
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (int f : fs.vf[static_cast<size_t>(v)]) {
+        const auto& c = fs.F[static_cast<size_t>(f)];
+        int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+        int a = c[static_cast<size_t>((k + 1) % 3)], b = c[static_cast<size_t>((k + 2) % 3)];
+        ring.push_back({a, b});
+        mean += S->row(a).transpose();
+      }
+      Eigen::Vector3d x;
+      if (mean.norm() > 0 && kernel_point(*S, ring, mean, &x)) S->row(v) = x.transpose();
+    }
+    std::vector<int> still;
+    for (int v : cand)
+      for (int f : fs.vf[static_cast<size_t>(v)])
+        if (fs.flipped(*S, f)) still.push_back(f);
+    std::sort(still.begin(), still.end());
+    still.erase(std::unique(still.begin(), still.end()), still.end());
+    bad.swap(still);
+  }
+  return bad.empty();
+}
+
+// Undoes the network's edge splits in reverse order on the map: each undo merges two pairs of
+// faces back into the input's; if a merged face flips (its quad was not convex on the
+// sphere), the neighbourhood is untangled before the next undo. Returns the number of
+// undos that needed untangling, or -1 if one could not be untangled.
+int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<char>& fixed_all, RowMat3d* S) {
+  FaceSet fs;
+  fs.F = net.F;
+  fs.alive.assign(fs.F.size(), 1);
+  fs.vf.resize(net.X.size());
+  for (size_t f = 0; f < fs.F.size(); ++f) fs.attach(static_cast<int>(f));
+  int untangled = 0;
+  for (size_t i = net.splits.size(); i-- > 0;) {
+    const auto& sp = net.splits[i];
+    std::vector<int> merged;
+    for (int t = 0; t < 2; ++t) {
+      int f = sp.f[static_cast<size_t>(t)], g = sp.g[static_cast<size_t>(t)];
+      if (f < 0) continue;
+      fs.detach(g);
+      fs.alive[static_cast<size_t>(g)] = 0;
+      fs.detach(f);
+      fs.F[static_cast<size_t>(f)] = sp.old[static_cast<size_t>(t)];
+      fs.attach(f);
+      if (fs.flipped(*S, f)) merged.push_back(f);
+    }
+    if (!merged.empty()) {
+      ++untangled;
+      untangle(fs, fixed_all, merged, S);  // a face left flipped here may be merged again below
+    }
+  }
+  // Whatever is still flipped at the end: untangle once more over the final faces.
+  std::vector<int> bad;
+  for (size_t f = 0; f < fs.F.size(); ++f)
+    if (fs.alive[f] && fs.flipped(*S, static_cast<int>(f))) bad.push_back(static_cast<int>(f));
+  if (!bad.empty() && !untangle(fs, fixed_all, bad, S)) return -1;
+  return untangled;
+}
+
+}  // namespace
+
+namespace {
+constexpr const char* kSteinerFailure = "a face stays flipped after removing the path network's Steiner vertices";
+
+Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const std::vector<int>& feature_vertices,
+                                                   const std::vector<Eigen::Vector3d>& targets_in,
+                                                   const ConstrainedParamOptions& options, const ProgressFn& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  ConstrainedParamResult result;
+  const SphereParamOptions& so = options.sphere;
+  if (so.effort < 0 || so.effort > 5) return Status(ErrorCode::InvalidArgument, "effort must be in 0..5");
+  if (feature_vertices.size() != targets_in.size())
+    return Status(ErrorCode::InvalidArgument, "need one target per feature (" + std::to_string(feature_vertices.size()) +
+                                                  " features, " + std::to_string(targets_in.size()) + " targets)");
+  const int k_given = static_cast<int>(feature_vertices.size());
+  for (int i = 0; i < k_given; ++i) {
+    int v = feature_vertices[static_cast<size_t>(i)];
+    if (v < 0 || v >= mesh.V.rows())
+      return Status(ErrorCode::InvalidInput, "feature " + std::to_string(i) + " names vertex " + std::to_string(v) +
+                                                 ", out of range (mesh has " + std::to_string(mesh.V.rows()) + ")");
+    const Eigen::Vector3d& t = targets_in[static_cast<size_t>(i)];
+    if (!t.allFinite() || std::abs(t.norm() - 1) > 1e-6)
+      return Status(ErrorCode::InvalidArgument, "target " + std::to_string(i) + " is not a unit vector");
+    for (int j = 0; j < i; ++j) {
+      if (feature_vertices[static_cast<size_t>(j)] == v)
+        return Status(ErrorCode::InvalidInput, "features " + std::to_string(j) + " and " + std::to_string(i) +
+                                                   " are on the same vertex " + std::to_string(v));
+      if (angle_between(targets_in[static_cast<size_t>(j)], t) < 1e-7)
+        return Status(ErrorCode::InvalidInput, "targets " + std::to_string(j) + " and " + std::to_string(i) +
+                                                   " coincide (closer than 1e-7 rad)");
+    }
+  }
+  std::vector<Eigen::Vector3d> targets;
+  for (const auto& t : targets_in) targets.push_back(t.normalized());
+
+  // 1. Check and close holes (as the unconstrained stage does).
+  MeshCheck check = check_mesh(mesh);
+  SPHEREKIT_RETURN_IF_ERROR(require_genus0(check, /*allow_boundary=*/true));
+  SPHEREKIT_ASSIGN_OR_RETURN(FilledMesh filled, fill_holes(mesh));
+  result.holes_filled = filled.holes;
+  const TriMesh& closed = filled.mesh;
+  const int n = static_cast<int>(closed.V.rows());
+  const int nf = static_cast<int>(closed.F.rows());
+  result.times.check = seconds_since(t_start);
+
+  auto finish_measure = [&](const RowMat3d& S, const std::vector<int>& fv) -> Status {
+    result.flipped_faces = count_flipped_faces(closed.F, S);
+    std::vector<char> real(static_cast<size_t>(nf), 0);
+    for (int f = 0; f < filled.original_faces; ++f) real[static_cast<size_t>(f)] = 1;
+    SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(closed, S, {}, &real));
+    result.efficiency = m.efficiency;
+    result.l2_stretch = m.l2_stretch;
+    result.linf_stretch = m.linf;
+    result.winding = m.winding;
+    result.max_feature_angle = 0;
+    for (int i = 0; i < k_given; ++i)
+      result.max_feature_angle = std::max(
+          result.max_feature_angle,
+          angle_between(S.row(fv[static_cast<size_t>(i)]).transpose(), targets_in[static_cast<size_t>(i)].normalized()));
+    result.map.S = S.topRows(filled.original_vertices);
+    result.map.provenance.library_version = kVersion;
+    result.map.provenance.method = "constrained";
+    result.map.provenance.options_digest = options_digest(options);
+    result.map.provenance.seed = so.seed;
+    result.times.total = seconds_since(t_start);
+    return Status();
+  };
+
+  // 2. Few features: start from the unconstrained map.
+  std::vector<int> fv = feature_vertices;
+  const bool need_unconstrained = k_given < 4 || !detail::targets_surround_origin(targets);
+  if (need_unconstrained) {
+    SphereParamOptions uo = so;
+    uo.align_rotation = false;
+    SPHEREKIT_ASSIGN_OR_RETURN(SphereParamResult u, parameterize_sphere(mesh, uo, progress));
+    if (u.flipped_faces != 0) return Status(ErrorCode::SolverFailed, "unconstrained map is not bijective");
+    // Rotate the map so the features come closest to their targets.
+    std::vector<Eigen::Vector3d> from;
+    for (int v : fv) from.push_back(u.map.S.row(v).transpose());
+    Eigen::Matrix3d R = k_given > 0 ? best_rotation(from, targets) : Eigen::Matrix3d::Identity();
+    RowMat3d S0 = u.map.S * R.transpose();
+    S0.rowwise().normalize();
+    if (k_given <= 1) {
+      // One feature: the rotated map puts it on its target up to rounding; snap it exactly
+      // and keep the result if the exact check still passes.
+      RowMat3d S1 = S0;
+      if (k_given == 1) S1.row(fv[0]) = targets[0].transpose();
+      if (count_flipped_faces(mesh.F, S1) == 0) {
+        result.flipped_faces = 0;
+        TriMesh open = mesh;
+        SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(open, S1));
+        result.efficiency = m.efficiency;
+        result.l2_stretch = m.l2_stretch;
+        result.linf_stretch = m.linf;
+        result.winding = m.winding;
+        result.max_feature_angle = k_given ? angle_between(S1.row(fv[0]).transpose(), targets[0]) : 0.0;
+        result.map.S = S1;
+        result.map.provenance.library_version = kVersion;
+        result.map.provenance.method = "constrained";
+        result.map.provenance.options_digest = options_digest(options);
+        result.map.provenance.seed = so.seed;
+        result.times.total = seconds_since(t_start);
+        return result;
+      }
+    }
+    // Auxiliary features: the vertices farthest (on the rotated map) from every target so
+    // far, until the targets surround the origin; their targets are where the rotated
+    // unconstrained map puts them, so they ask for no distortion of their own.
+    std::vector<char> used(static_cast<size_t>(filled.original_vertices), 0);
+    for (int v : fv) used[static_cast<size_t>(v)] = 1;
+    while (static_cast<int>(fv.size()) < 4 || !detail::targets_surround_origin(targets)) {
+      if (fv.size() >= static_cast<size_t>(k_given) + 8 || fv.size() >= static_cast<size_t>(filled.original_vertices))
+        return Status(ErrorCode::SolverFailed, "could not complete the feature set with auxiliary features");
+      int best = -1;
+      double best_d = -1;
+      for (int v = 0; v < filled.original_vertices; ++v) {
+        if (used[static_cast<size_t>(v)]) continue;
+        Eigen::Vector3d p = S0.row(v).transpose();
+        double d = 1e300;
+        for (const auto& t : targets) d = std::min(d, angle_between(p, t));
+        if (d > best_d) {
+          best_d = d;
+          best = v;
+        }
+      }
+      used[static_cast<size_t>(best)] = 1;
+      fv.push_back(best);
+      targets.push_back(S0.row(best).transpose());
+    }
+    result.network.auxiliary_features = static_cast<int>(fv.size()) - k_given;
+  }
+  const int k = static_cast<int>(fv.size());
+
+  // 3. Normalize (centre, unit bounding-box diagonal) as the unconstrained stage does.
+  Eigen::RowVector3d lo = closed.V.colwise().minCoeff(), hi = closed.V.colwise().maxCoeff();
+  double diag = (hi - lo).norm();
+  if (!(diag > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
+  RowMat3d Pn = (closed.V.rowwise() - 0.5 * (lo + hi)) / diag;
+
+  // 4. Path network.
+  auto t0 = std::chrono::steady_clock::now();
+  detail::NetworkOptions no;
+  no.steiner_penalty = options.steiner_penalty;
+  no.min_angle_deg = options.min_angle_deg;
+  no.extremity_fraction = options.extremity_fraction;
+  no.sidedness = options.sidedness;
+  no.unswirl = options.unswirl;
+  no.edge_flips = options.edge_flips;
+  SPHEREKIT_ASSIGN_OR_RETURN(detail::PathNetwork net, detail::build_path_network(Pn, closed.F, fv, targets, no, progress));
+  result.times.network = seconds_since(t0);
+  auto& rep = result.network;
+  rep.paths = static_cast<int>(net.paths.size());
+  rep.total_length = net.total_length * diag;
+  rep.max_ratio = net.max_ratio;
+  rep.swirls_fixed = net.swirls_fixed;
+  rep.edge_flips = net.edge_flips;
+  rep.deferred = net.deferred;
+  rep.steiner_vertices = static_cast<int>(net.steiner_parent.size());
+  rep.arc_targets = targets;
+  for (const auto& p : net.paths) {
+    rep.arcs.push_back({p.a, p.b});
+    std::vector<Eigen::Vector3d> line;
+    for (int v : p.verts) line.push_back(net.X[static_cast<size_t>(v)] * diag + (0.5 * (lo + hi)).transpose());
+    rep.polylines.push_back(std::move(line));
+  }
+
+  // 5. Constrained progressive mesh of the network mesh: its base is the triangulation.
+  t0 = std::chrono::steady_clock::now();
+  const int nn = static_cast<int>(net.X.size());
+  const int nnf = static_cast<int>(net.F.size());
+  RowMatXd Pnet(nn, 3);
+  for (int v = 0; v < nn; ++v) Pnet.row(v) = net.X[static_cast<size_t>(v)].transpose();
+  RowMat3i Fnet(nnf, 3);
+  for (int f = 0; f < nnf; ++f)
+    for (int c = 0; c < 3; ++c) Fnet(f, c) = net.F[static_cast<size_t>(f)][static_cast<size_t>(c)];
+  ProgressiveMeshOptions pmo;
+  pmo.keep_vertices.assign(static_cast<size_t>(nn), 0);
+  for (int v : fv) pmo.keep_vertices[static_cast<size_t>(v)] = 1;
+  for (const auto& p : net.paths)
+    for (size_t i = 1; i < p.verts.size(); ++i) pmo.constraint_edges.push_back({p.verts[i - 1], p.verts[i]});
+  pmo.target_vertices = k;
+  SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(Pnet, Fnet, pmo, progress));
+  if (static_cast<int>(pm.base_vertices.size()) != k || static_cast<int>(pm.base_faces.size()) != 2 * k - 4)
+    return Status(ErrorCode::SolverFailed, "constrained simplification did not reach the feature triangulation");
+  result.times.simplify = seconds_since(t0);
+
+  // 6. Coarse-to-fine refinement with the features fixed on their targets.
+  t0 = std::chrono::steady_clock::now();
+  detail::OptimizerSettings settings = detail::settings_for_effort(so.effort);
+  settings.regularizer_weight = so.regularizer_weight;
+  settings.seed = so.seed;
+  settings.threads = so.threads;
+  std::vector<double> wnet(static_cast<size_t>(nnf), 1.0), snet(static_cast<size_t>(nnf), 0.0);
+  for (int f = 0; f < nnf; ++f)
+    if (net.face_origin[static_cast<size_t>(f)] >= filled.original_faces) {
+      wnet[static_cast<size_t>(f)] = so.hole_weight;
+      snet[static_cast<size_t>(f)] = so.hole_shape_weight;
+    }
+  detail::EmbedInput in;
+  in.P = &Pnet;
+  in.pm = &pm;
+  in.face_weight = wnet;
+  in.face_shape_weight = snet;
+  in.base_positions = RowMat3d::Zero(nn, 3);
+  in.fixed.assign(static_cast<size_t>(nn), 0);
+  for (int i = 0; i < k; ++i) {
+    in.base_positions.row(fv[static_cast<size_t>(i)]) = targets[static_cast<size_t>(i)].transpose();
+    in.fixed[static_cast<size_t>(fv[static_cast<size_t>(i)])] = 1;
+  }
+  const bool has_steiner = nn > n;
+  detail::OptimizerSettings net_settings = settings;
+  if (has_steiner) net_settings.final_iter = 1;  // the final pass runs on the input connectivity below
+  RowMat3d Snet;
+  SPHEREKIT_RETURN_IF_ERROR(detail::embed_coarse_to_fine(in, net_settings, progress, &Snet, nullptr));
+
+  // 7. Drop the Steiner vertices: the input's faces are unions of network faces, valid as
+  //    long as each split edge's quad stays convex on the sphere (checked exactly).
+  RowMat3d S = Snet.topRows(n);
+  std::vector<char> fixed(static_cast<size_t>(n), 0);
+  for (int v : fv) fixed[static_cast<size_t>(v)] = 1;
+  if (has_steiner) {
+    // Rarely, a split edge's quad is not convex on the sphere and a merged face flips: the
+    // neighbourhood is untangled (features stay fixed), then the final pass smooths it out.
+    std::vector<char> fixed_net(static_cast<size_t>(nn), 0);
+    for (int v : fv) fixed_net[static_cast<size_t>(v)] = 1;
+    RowMat3d Sw = Snet;
+    int untangled = remove_steiner_vertices(net, fixed_net, &Sw);
+    if (untangled < 0)
+      return Status(ErrorCode::SolverFailed, kSteinerFailure);
+    result.network.flips_after_steiner_removal = untangled;
+    S = Sw.topRows(n);
+    if (int flips = count_flipped_faces(closed.F, S); flips != 0)
+      return Status(ErrorCode::Internal, std::to_string(flips) + " faces flipped after removing Steiner vertices");
+    std::vector<double> w(static_cast<size_t>(nf), 1.0), sw(static_cast<size_t>(nf), 0.0);
+    for (int f = filled.original_faces; f < nf; ++f) {
+      w[static_cast<size_t>(f)] = so.hole_weight;
+      sw[static_cast<size_t>(f)] = so.hole_shape_weight;
+    }
+    RowMatXd P = Pn;
+    SPHEREKIT_RETURN_IF_ERROR(optimize_in_place(P, closed.F, w, sw, fixed, settings, progress, &S));
+  }
+  result.times.refine = seconds_since(t0);
+  SPHEREKIT_RETURN_IF_ERROR(finish_measure(S, fv));
+  return result;
+}
+
+}  // namespace
+
+Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& mesh,
+                                                               const std::vector<int>& feature_vertices,
+                                                               const std::vector<Eigen::Vector3d>& targets,
+                                                               const ConstrainedParamOptions& options,
+                                                               const ProgressFn& progress) {
+  // Removing the Steiner vertices can leave a face flipped that local untangling cannot
+  // repair (a non-convex quad next to fixed features). A network routed with another
+  // Steiner cost puts them elsewhere: retry a few deterministic variants before failing.
+  const double factors[] = {1.0, 0.75, 1.5, 0.6, 2.5};
+  Status last;
+  int attempt = 0;
+  for (double f : factors) {
+    ConstrainedParamOptions o = options;
+    o.steiner_penalty = std::max(1.05, options.steiner_penalty * f);
+    Result<ConstrainedParamResult> r = constrained_attempt(mesh, feature_vertices, targets, o, progress);
+    ++attempt;
+    if (r.ok()) {
+      r.value().network.attempts = attempt;
+      return r;
+    }
+    last = r.status();
+    if (last.code() != ErrorCode::SolverFailed || last.message() != kSteinerFailure) return last;
+  }
+  return Status(ErrorCode::SolverFailed, std::string(kSteinerFailure) + " (after " + std::to_string(attempt) + " network variants)");
+}
+
+}  // namespace spherekit

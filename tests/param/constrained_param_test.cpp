@@ -1,0 +1,269 @@
+// Constrained spherical parameterization (Asirvatham et al. 2005 §4): features exactly on
+// their targets, bijective maps, a path network isomorphic to the arc network, errors.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+#include "detail/path_network.h"
+#include "spherekit/constrained_param.h"
+#include "spherekit/fill_holes.h"
+#include "spherekit/metrics.h"
+#include "spherekit/predicates.h"
+#include "test_meshes.h"
+
+using namespace spherekit;
+
+namespace {
+
+void require_valid_map(const TriMesh& mesh, const RowMat3d& S) {
+  REQUIRE(S.rows() == mesh.V.rows());
+  for (Eigen::Index i = 0; i < S.rows(); ++i) REQUIRE(std::abs(S.row(i).norm() - 1.0) < 1e-12);
+  REQUIRE(count_flipped_faces(mesh.F, S) == 0);
+  auto m = evaluate_sphere_map(mesh, S);
+  REQUIRE(m.ok());
+  if (m->closed) REQUIRE(std::abs(m->winding - 1.0) < 1e-9);
+}
+
+void require_on_targets(const RowMat3d& S, const std::vector<int>& fv, const std::vector<Eigen::Vector3d>& t) {
+  for (size_t i = 0; i < fv.size(); ++i) {
+    Eigen::Vector3d p = S.row(fv[i]).transpose();
+    double angle = std::atan2(p.cross(t[i]).norm(), p.dot(t[i]));
+    REQUIRE(angle < 1e-9);
+  }
+}
+
+// Features spread over a mesh: the vertices closest to the given directions from the centroid.
+std::vector<int> pick_features(const TriMesh& m, const std::vector<Eigen::Vector3d>& dirs) {
+  Eigen::RowVector3d c = m.V.colwise().mean();
+  std::vector<int> out;
+  for (const auto& d : dirs) {
+    int best = -1;
+    double bd = -2;
+    for (int v = 0; v < m.V.rows(); ++v) {
+      Eigen::Vector3d p = (m.V.row(v) - c).transpose().normalized();
+      if (p.dot(d) > bd && std::find(out.begin(), out.end(), v) == out.end()) {
+        bd = p.dot(d);
+        best = v;
+      }
+    }
+    out.push_back(best);
+  }
+  return out;
+}
+
+std::vector<Eigen::Vector3d> octahedron_dirs() {
+  return {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+}
+
+// Targets: the features' radial directions rotated and jittered (seeded), as if they came
+// from another mesh's map.
+std::vector<Eigen::Vector3d> jittered_targets(const TriMesh& m, const std::vector<int>& fv, double jitter,
+                                              std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0, 1);
+  Eigen::RowVector3d c = m.V.colwise().mean();
+  Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  std::vector<Eigen::Vector3d> t;
+  for (int v : fv) {
+    Eigen::Vector3d p = R * (m.V.row(v) - c).transpose().normalized();
+    p += jitter * Eigen::Vector3d(g(rng), g(rng), g(rng));
+    t.push_back(p.normalized());
+  }
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("constrained map puts every feature exactly on its target", "[param][constrained]") {
+  TriMesh m = test::icosphere(3);
+  std::vector<Eigen::Vector3d> dirs = octahedron_dirs();
+  for (const auto& d : std::vector<Eigen::Vector3d>{{1, 1, 1}, {-1, 1, -1}, {1, -1, -1}, {-1, -1, 1}})
+    dirs.push_back(d.normalized());
+  std::vector<int> fv = pick_features(m, dirs);
+  std::vector<Eigen::Vector3d> t = jittered_targets(m, fv, 0.08, 7);
+  auto r = parameterize_sphere_constrained(m, fv, t);
+  REQUIRE(r.ok());
+  require_valid_map(m, r->map.S);
+  require_on_targets(r->map.S, fv, t);
+  CHECK(r->max_feature_angle < 1e-9);
+  CHECK(r->network.paths == 3 * static_cast<int>(fv.size()) - 6);
+  CHECK(r->network.auxiliary_features == 0);
+  CHECK(r->efficiency > 0.5);
+}
+
+TEST_CASE("constrained map on a bumpy blob and on a sphere with holes", "[param][constrained]") {
+  SECTION("blob") {
+    TriMesh m = test::random_blob(3, 11);
+    std::vector<int> fv = pick_features(m, octahedron_dirs());
+    std::vector<Eigen::Vector3d> t = jittered_targets(m, fv, 0.1, 3);
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.ok());
+    require_valid_map(m, r->map.S);
+    require_on_targets(r->map.S, fv, t);
+  }
+  SECTION("holes") {
+    TriMesh m = test::sphere_with_holes(3, 2);
+    std::vector<int> fv = pick_features(m, octahedron_dirs());
+    std::vector<Eigen::Vector3d> t = jittered_targets(m, fv, 0.05, 5);
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.ok());
+    CHECK(r->holes_filled == 2);
+    REQUIRE(count_flipped_faces(m.F, r->map.S) == 0);
+    require_on_targets(r->map.S, fv, t);
+  }
+}
+
+TEST_CASE("one, two and three features get auxiliary features or a rotation", "[param][constrained]") {
+  TriMesh m = test::random_blob(2, 4);
+  std::vector<int> all = pick_features(m, octahedron_dirs());
+  std::vector<Eigen::Vector3d> tall = jittered_targets(m, all, 0.05, 9);
+  for (int k = 1; k <= 3; ++k) {
+    std::vector<int> fv(all.begin(), all.begin() + k);
+    std::vector<Eigen::Vector3d> t(tall.begin(), tall.begin() + k);
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    INFO("features " << k);
+    REQUIRE(r.ok());
+    require_valid_map(m, r->map.S);
+    require_on_targets(r->map.S, fv, t);
+    if (k >= 2) CHECK(r->network.auxiliary_features >= 4 - k);
+  }
+}
+
+TEST_CASE("targets crowded into one hemisphere are completed with auxiliary features", "[param][constrained]") {
+  TriMesh m = test::icosphere(3);
+  std::vector<Eigen::Vector3d> dirs = {{0, 0, 1}, {0.5, 0, 0.8}, {-0.5, 0, 0.8}, {0, 0.5, 0.8}, {0, -0.5, 0.8}};
+  for (auto& d : dirs) d.normalize();
+  std::vector<int> fv = pick_features(m, dirs);
+  std::vector<Eigen::Vector3d> t;
+  for (int v : fv) t.push_back(m.V.row(v).transpose().normalized());
+  REQUIRE_FALSE(detail::targets_surround_origin(t));
+  auto r = parameterize_sphere_constrained(m, fv, t);
+  REQUIRE(r.ok());
+  CHECK(r->network.auxiliary_features > 0);
+  require_valid_map(m, r->map.S);
+  require_on_targets(r->map.S, fv, t);
+}
+
+TEST_CASE("path network and arc network have the same rotation system", "[param][constrained][network]") {
+  TriMesh m = test::random_blob(3, 21);
+  std::vector<Eigen::Vector3d> dirs = octahedron_dirs();
+  for (const auto& d : std::vector<Eigen::Vector3d>{{1, 1, 1}, {-1, 1, -1}, {1, -1, -1}, {-1, -1, 1}, {1, 1, -1}})
+    dirs.push_back(d.normalized());
+  std::vector<int> fv = pick_features(m, dirs);
+  std::vector<Eigen::Vector3d> t = jittered_targets(m, fv, 0.1, 13);
+  RowMat3d V = m.V;
+  auto r = detail::build_path_network(V, m.F, fv, t, {}, {});
+  REQUIRE(r.ok());
+  const auto& net = r.value();
+  const int k = static_cast<int>(fv.size());
+  REQUIRE(static_cast<int>(net.paths.size()) == 3 * k - 6);
+  REQUIRE(static_cast<int>(net.triangles.size()) == 2 * k - 4);
+  // Every spherical triangle is ccw, by the exact predicate.
+  for (const auto& tri : net.triangles) REQUIRE(orient3d_origin(t[tri[0]], t[tri[1]], t[tri[2]]) > 0);
+  // Paths are vertex-disjoint except at their end features, and consecutive vertices are mesh edges.
+  std::vector<int> owner(net.X.size(), -1);
+  std::vector<std::vector<int>> vf(net.X.size());
+  for (size_t f = 0; f < net.F.size(); ++f)
+    for (int v : net.F[f]) vf[static_cast<size_t>(v)].push_back(static_cast<int>(f));
+  for (size_t p = 0; p < net.paths.size(); ++p) {
+    const auto& verts = net.paths[p].verts;
+    REQUIRE(verts.front() == fv[static_cast<size_t>(net.paths[p].a)]);
+    REQUIRE(verts.back() == fv[static_cast<size_t>(net.paths[p].b)]);
+    for (size_t i = 1; i + 1 < verts.size(); ++i) {
+      REQUIRE(owner[static_cast<size_t>(verts[i])] == -1);
+      owner[static_cast<size_t>(verts[i])] = static_cast<int>(p);
+    }
+  }
+  // Around each feature, the ccw order of the paths' first edges on the mesh equals the ccw
+  // order of the arcs on the sphere.
+  for (int f = 0; f < k; ++f) {
+    const int v = fv[static_cast<size_t>(f)];
+    std::vector<std::array<int, 2>> pairs;
+    for (int face : vf[static_cast<size_t>(v)]) {
+      const auto& c = net.F[static_cast<size_t>(face)];
+      int i = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+      pairs.push_back({c[static_cast<size_t>((i + 1) % 3)], c[static_cast<size_t>((i + 2) % 3)]});
+    }
+    std::vector<int> ring{pairs[0][0]};
+    while (ring.size() < pairs.size())
+      for (const auto& pr : pairs)
+        if (pr[0] == ring.back()) {
+          ring.push_back(pr[1]);
+          break;
+        }
+    std::vector<std::pair<int, int>> mesh_order, sphere_order;  // (position, other feature)
+    Eigen::Vector3d n = t[static_cast<size_t>(f)];
+    Eigen::Vector3d e1 = (std::abs(n.x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY());
+    e1 = (e1 - e1.dot(n) * n).normalized();
+    Eigen::Vector3d e2 = n.cross(e1);
+    std::vector<std::pair<double, int>> ang;
+    for (const auto& p : net.paths) {
+      if (p.a != f && p.b != f) continue;
+      int other = p.a == f ? p.b : p.a;
+      int first = p.a == f ? p.verts[1] : p.verts[p.verts.size() - 2];
+      int pos = static_cast<int>(std::find(ring.begin(), ring.end(), first) - ring.begin());
+      REQUIRE(pos < static_cast<int>(ring.size()));
+      mesh_order.push_back({pos, other});
+      Eigen::Vector3d d = t[static_cast<size_t>(other)] - t[static_cast<size_t>(other)].dot(n) * n;
+      ang.push_back({std::atan2(d.dot(e2), d.dot(e1)), other});
+    }
+    std::sort(mesh_order.begin(), mesh_order.end());
+    std::sort(ang.begin(), ang.end());
+    std::vector<int> a, b;
+    for (const auto& x : mesh_order) a.push_back(x.second);
+    for (const auto& x : ang) b.push_back(x.second);
+    // Equal as cyclic sequences.
+    auto it = std::find(b.begin(), b.end(), a[0]);
+    REQUIRE(it != b.end());
+    std::rotate(b.begin(), it, b.end());
+    REQUIRE(a == b);
+  }
+}
+
+TEST_CASE("infeasible constraints are refused with a clear error", "[param][constrained][errors]") {
+  TriMesh m = test::icosphere(2);
+  std::vector<int> fv = pick_features(m, octahedron_dirs());
+  std::vector<Eigen::Vector3d> t = jittered_targets(m, fv, 0.0, 1);
+  SECTION("two features on one vertex") {
+    fv[1] = fv[0];
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.status().code() == ErrorCode::InvalidInput);
+    CHECK(r.status().message().find("same vertex") != std::string::npos);
+  }
+  SECTION("coinciding targets") {
+    t[2] = t[1];
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.status().code() == ErrorCode::InvalidInput);
+    CHECK(r.status().message().find("coincide") != std::string::npos);
+  }
+  SECTION("target not a unit vector") {
+    t[0] *= 2;
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.status().code() == ErrorCode::InvalidArgument);
+  }
+  SECTION("feature index out of range") {
+    fv[0] = static_cast<int>(m.V.rows());
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.status().code() == ErrorCode::InvalidInput);
+  }
+  SECTION("count mismatch") {
+    t.pop_back();
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.status().code() == ErrorCode::InvalidArgument);
+  }
+}
+
+TEST_CASE("constrained map is deterministic", "[param][constrained]") {
+  TriMesh m = test::random_blob(2, 8);
+  std::vector<int> fv = pick_features(m, octahedron_dirs());
+  std::vector<Eigen::Vector3d> t = jittered_targets(m, fv, 0.05, 2);
+  ConstrainedParamOptions o1, o2;
+  o1.sphere.threads = 1;
+  o2.sphere.threads = 2;
+  auto a = parameterize_sphere_constrained(m, fv, t, o1);
+  auto b = parameterize_sphere_constrained(m, fv, t, o2);
+  REQUIRE(a.ok());
+  REQUIRE(b.ok());
+  REQUIRE(a->map.S == b->map.S);
+}

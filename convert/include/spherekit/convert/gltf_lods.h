@@ -1,0 +1,97 @@
+// Levels of detail of a geometry image as Draco-compressed binary glTF: one .glb per level, and
+// one .glb holding every level with MSFT_lod.
+//
+// Levels. Level k is the geometry image subsampled to (N-1)/2^k + 1 texels per side (257, 129,
+// 65, 33, ...): the octahedral lattices nest, so each level is the remesh the image of that
+// size defines (geometry_image_mesh), with the texture coordinates of the full image
+// (gltf_mesh.h), so one texture or normal map made from the image serves every level.
+//
+// Per primitive: POSITION, NORMAL, TEXCOORD_0 in a KHR_draco_mesh_compression bitstream, no
+// uncompressed fallback (the extension is required), accessors written from the decoded data
+// (gltf_draco.h). All levels share one position grid (that of level 0), so a texel present in
+// several levels decodes to the same position in each.
+//
+// The combined file (MSFT_lod README, KhronosGroup/glTF extensions/2.0/Vendor/MSFT_lod):
+//   scene 0 -> node 0 "NAME_LOD0" (mesh 0) with
+//              extensions.MSFT_lod.ids = [1, 2, ..., L-1]   (progressively coarser)
+//              extras.MSFT_screencoverage = [c0, c1, ..., c(L-1)]
+//   nodes 1..L-1 "NAME_LODk" (mesh k), referenced only by the ids
+// so a loader without MSFT_lod shows level 0, the best one (ALGORITHM.md §7, gotcha 11).
+// MSFT_screencoverage holds, per level, the smallest screen coverage at which it is used: level k
+// from c(k-1) down to c(k). Coverage thresholds halve with the level, like the sample spacing,
+// so the projected edge length stays within a factor of two; the last level is used down to
+// `lowest_coverage` (0: never culled).
+//
+// Provenance and quantization are recorded in extras: asset.extras.spherekit (toolkit and
+// format version, source mesh, sphere map, layout, texture coordinate convention) and, per
+// mesh, extras.spherekit (level, image size, quantization with its error budget).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "spherekit/convert/gltf_draco.h"
+#include "spherekit/convert/gltf_mesh.h"
+#include "spherekit/geometry_image.h"
+#include "spherekit/progress.h"
+#include "spherekit/status.h"
+
+namespace spherekit::convert {
+
+/// Where the asset came from (asset.extras.spherekit).
+struct GltfProvenance {
+  std::string source_mesh;  ///< path or name of the mesh
+  std::string sphere_map;   ///< path or name of the sphere map
+};
+
+struct GltfLodOptions {
+  // Shape-defining
+  int levels = 4;  ///< number of levels (>= 1); (N-1)/2^(levels-1) must be >= 2
+  QuantizationBudget budget;  ///< how the quantization is chosen (gltf_draco.h)
+  /// RMS surface error of level 0 against the original mesh (absolute units; remesh_error().rms
+  /// of geometry_image_mesh(image)): the position bits' error budget. <= 0: unknown, the
+  /// budget's minimum bits are used.
+  double reference_rms_error = 0;
+  double lod0_coverage = 0.5;   ///< MSFT_screencoverage of level 0 (coverage where level 1 takes over)
+  double lowest_coverage = 0;   ///< MSFT_screencoverage of the last level (0: never culled)
+  std::string name = "mesh";    ///< node and mesh names: NAME_LOD0, NAME_LOD1, ...
+  GltfProvenance provenance;
+  // Effort
+  int compression_level = 7;    ///< Draco compression level 0..10 (gltf_draco.h)
+};
+
+/// One level of detail.
+struct GltfLodLevel {
+  int image_size = 0;         ///< texels per side of the level's geometry image
+  DracoPrimitive primitive;   ///< the Draco bitstream and its decode
+  std::string glb;            ///< the level alone as a .glb
+};
+
+struct GltfLods {
+  std::vector<GltfLodLevel> levels;      ///< level 0 (finest) first
+  std::string combined_glb;              ///< every level, MSFT_lod
+  QuantizationChoice quantization;       ///< shared by all levels
+  std::vector<double> screen_coverage;   ///< MSFT_screencoverage, one per level
+};
+
+/// Builds the levels of detail of `image` (in memory). Reports progress as stage "gltf" (level =
+/// level index, fraction = levels done / levels) and stops with Cancelled when the callback
+/// returns false. Errors: InvalidArgument (malformed image, levels < 1 or too many for the
+/// image size, coverages not in [0, 1] or lod0_coverage < lowest_coverage), Internal (Draco or
+/// tinygltf failed), Cancelled.
+[[nodiscard]] Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOptions& options = {},
+                                               const ProgressFn& progress = {});
+
+/// The file names write_gltf_lods uses: PREFIX_lod0.glb ... PREFIX_lod{L-1}.glb, PREFIX_lods.glb.
+struct GltfLodPaths {
+  std::vector<std::string> levels;
+  std::string combined;
+};
+GltfLodPaths gltf_lod_paths(const std::string& prefix, int levels);
+
+/// Writes every level and the combined file, each atomically (formats::write_file_atomic), to
+/// gltf_lod_paths(prefix, lods.levels.size()). Errors: IoError (the first failing file; files
+/// already written stay).
+[[nodiscard]] Result<GltfLodPaths> write_gltf_lods(const std::string& prefix, const GltfLods& lods);
+
+}  // namespace spherekit::convert

@@ -1,0 +1,150 @@
+// Levels of detail of a geometry image as Draco glTF, per level and combined with MSFT_lod (see
+// gltf_lods.h).
+//
+// References: MSFT_lod README (KhronosGroup/glTF, extensions/2.0/Vendor/MSFT_lod: "ids" on the
+// highest level, MSFT_screencoverage in extras); KHR_draco_mesh_compression README;
+// ALGORITHM.md §5.1-5.2 and §7 gotchas 9 and 11.
+#include "spherekit/convert/gltf_lods.h"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "gltf_document.h"
+#include "spherekit/formats/atomic_file.h"
+
+namespace spherekit::convert {
+namespace {
+
+// mesh.extras.spherekit of one level.
+tinygltf::Value level_extras(int level, int image_size, int texture_size, const QuantizationChoice& q) {
+  tinygltf::Value::Object o;
+  o["lod"] = detail::json_int(level);
+  o["geometry_image_size"] = detail::json_int(image_size);
+  o["texture_size"] = detail::json_int(texture_size);
+  o["quantization"] = detail::quantization_json(q, true, true);
+  tinygltf::Value::Object extras;
+  extras["spherekit"] = detail::json_object(std::move(o));
+  return detail::json_object(std::move(extras));
+}
+
+tinygltf::Value asset_extras(const GltfLodOptions& options, int texture_size, int levels) {
+  tinygltf::Value::Object o;
+  o["source_mesh"] = detail::json_string(options.provenance.source_mesh);
+  o["sphere_map"] = detail::json_string(options.provenance.sphere_map);
+  o["layout"] = detail::json_string("octahedral");
+  o["geometry_image_size"] = detail::json_int(texture_size);
+  o["levels"] = detail::json_int(levels);
+  o["texcoord"] = detail::json_string(
+      "TEXCOORD_0 = texel centre ((j + 0.5) / T, (i + 0.5) / T) of texel (row i, column j) of the T x T "
+      "geometry image, T = geometry_image_size; octahedral domain u = -1 + 2j/(T-1), v = -1 + 2i/(T-1)");
+  return detail::provenance_json(std::move(o));
+}
+
+std::string level_name(const std::string& name, int level) { return name + "_LOD" + std::to_string(level); }
+
+}  // namespace
+
+GltfLodPaths gltf_lod_paths(const std::string& prefix, int levels) {
+  GltfLodPaths paths;
+  for (int k = 0; k < levels; ++k) paths.levels.push_back(prefix + "_lod" + std::to_string(k) + ".glb");
+  paths.combined = prefix + "_lods.glb";
+  return paths;
+}
+
+Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOptions& options,
+                                 const ProgressFn& progress) {
+  const int n = image.size;
+  if (!is_geometry_image_size(n)) return Status(ErrorCode::InvalidArgument, "malformed geometry image");
+  if (options.levels < 1 || options.levels > 30 || ((n - 1) >> (options.levels - 1)) < 2)
+    return Status(ErrorCode::InvalidArgument, std::to_string(options.levels) + " levels of detail do not fit a " +
+                                                  std::to_string(n) + " x " + std::to_string(n) +
+                                                  " geometry image (the coarsest level needs >= 3 x 3 texels)");
+  if (!(options.lod0_coverage >= 0 && options.lod0_coverage <= 1) ||
+      !(options.lowest_coverage >= 0 && options.lowest_coverage <= options.lod0_coverage))
+    return Status(ErrorCode::InvalidArgument, "screen coverages must satisfy 0 <= lowest_coverage <= lod0_coverage <= 1");
+
+  GltfLods out;
+  SPHEREKIT_ASSIGN_OR_RETURN(GltfMesh finest, gltf_mesh_from_geometry_image(image));
+  SPHEREKIT_ASSIGN_OR_RETURN(out.quantization,
+                             choose_draco_quantization(finest, options.reference_rms_error, options.budget));
+  DracoEncodeOptions encode;
+  encode.quantization = out.quantization.quantization;
+  encode.compression_level = options.compression_level;
+
+  for (int k = 0; k < options.levels; ++k) {
+    if (!report_progress(progress, "gltf", k, static_cast<double>(k) / options.levels))
+      return Status(ErrorCode::Cancelled, "cancelled");
+    GltfLodLevel level;
+    level.image_size = (n - 1) / (1 << k) + 1;
+    GltfMesh mesh;
+    if (k == 0) {
+      mesh = std::move(finest);
+    } else {
+      SPHEREKIT_ASSIGN_OR_RETURN(GeometryImage sub, subsample_geometry_image(image, level.image_size));
+      SPHEREKIT_ASSIGN_OR_RETURN(mesh, gltf_mesh_from_geometry_image(sub, n));
+    }
+    SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(mesh, encode));
+
+    detail::GlbBuilder doc;
+    const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
+                                     level_extras(k, level.image_size, n, out.quantization));
+    tinygltf::Node node;
+    node.name = level_name(options.name, k);
+    node.mesh = m;
+    doc.model().nodes.push_back(std::move(node));
+    doc.model().scenes.emplace_back();
+    doc.model().scenes[0].nodes = {0};
+    doc.model().defaultScene = 0;
+    doc.model().asset.extras = asset_extras(options, n, 1);
+    SPHEREKIT_ASSIGN_OR_RETURN(level.glb, doc.to_glb());
+    out.levels.push_back(std::move(level));
+  }
+
+  // Screen coverage: halves per level (the sample spacing doubles), the last level down to
+  // lowest_coverage.
+  for (int k = 0; k < options.levels; ++k)
+    out.screen_coverage.push_back(k + 1 == options.levels ? options.lowest_coverage
+                                                          : options.lod0_coverage / static_cast<double>(1 << k));
+
+  detail::GlbBuilder doc;
+  tinygltf::Value::Array ids;
+  for (int k = 0; k < options.levels; ++k) {
+    const GltfLodLevel& level = out.levels[static_cast<std::size_t>(k)];
+    const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
+                                     level_extras(k, level.image_size, n, out.quantization));
+    tinygltf::Node node;
+    node.name = level_name(options.name, k);
+    node.mesh = m;
+    doc.model().nodes.push_back(std::move(node));
+    if (k > 0) ids.push_back(detail::json_int(k));
+  }
+  if (options.levels > 1) {
+    // MSFT_lod on the highest level; "ids" needs at least one entry (schema minItems 1).
+    tinygltf::Node& top = doc.model().nodes[0];
+    tinygltf::Value::Object lod;
+    lod["ids"] = tinygltf::Value(std::move(ids));
+    top.extensions["MSFT_lod"] = detail::json_object(std::move(lod));
+    tinygltf::Value::Object extras;
+    extras["MSFT_screencoverage"] = detail::json_array(out.screen_coverage);
+    top.extras = detail::json_object(std::move(extras));
+    doc.use_extension("MSFT_lod", false);
+  }
+  doc.model().scenes.emplace_back();
+  doc.model().scenes[0].nodes = {0};
+  doc.model().defaultScene = 0;
+  doc.model().asset.extras = asset_extras(options, n, options.levels);
+  SPHEREKIT_ASSIGN_OR_RETURN(out.combined_glb, doc.to_glb());
+  if (!report_progress(progress, "gltf", options.levels, 1.0)) return Status(ErrorCode::Cancelled, "cancelled");
+  return out;
+}
+
+Result<GltfLodPaths> write_gltf_lods(const std::string& prefix, const GltfLods& lods) {
+  GltfLodPaths paths = gltf_lod_paths(prefix, static_cast<int>(lods.levels.size()));
+  for (std::size_t k = 0; k < lods.levels.size(); ++k)
+    SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic(paths.levels[k], lods.levels[k].glb));
+  SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic(paths.combined, lods.combined_glb));
+  return paths;
+}
+
+}  // namespace spherekit::convert

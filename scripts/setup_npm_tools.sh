@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# Installs the npm tools the glTF tests run (Khronos gltf-validator, Google's draco3d decoder)
+# into a folder outside the repository. Idempotent: when the pinned versions are present it
+# prints their folder and touches nothing else (no network). Concurrent runs wait for each
+# other (flock on DIR/.lock).
+#   bash scripts/setup_npm_tools.sh [DIR] [--compare]
+#     DIR        default $SPHEREKIT_NPM_DIR, else ~/.cache/spherekit/npm-tools
+#     --compare  also the size-comparison peers @gltf-transform/cli and gltfpack (not needed
+#                by the tests)
+# Exit: 0 ready; 3 node/npm missing or the install failed (the tests skip with this message).
+set -euo pipefail
+
+dir=""
+compare=0
+for arg in "$@"; do
+  case "$arg" in
+    --compare) compare=1 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    -*) echo "setup_npm_tools: unknown option '$arg'" >&2; exit 2 ;;
+    *) dir="$arg" ;;
+  esac
+done
+dir="${dir:-${SPHEREKIT_NPM_DIR:-$HOME/.cache/spherekit/npm-tools}}"
+
+# Pinned: the versions ECOSYSTEM.md validated (0 errors/0 warnings on Draco .glb).
+packages=(gltf-validator@2.0.0-dev.3.10 draco3d@1.5.9)
+if [[ "$compare" == 1 ]]; then packages+=(@gltf-transform/cli@4.5.1 gltfpack@1.3.0); fi
+
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  echo "setup_npm_tools: node and npm are not installed (e.g. apt-get install nodejs npm)" >&2
+  exit 3
+fi
+
+installed_version() {  # installed_version NAME -> version or nothing
+  local pj="$dir/node_modules/$1/package.json"
+  [[ -f "$pj" ]] && node -p "require(process.argv[1]).version" "$pj" 2>/dev/null || true
+}
+
+missing() {
+  local spec name version out=()
+  for spec in "${packages[@]}"; do
+    name="${spec%@*}"; version="${spec##*@}"
+    [[ "$(installed_version "$name")" == "$version" ]] || out+=("$spec")
+  done
+  echo "${out[@]:-}"
+}
+
+mkdir -p "$dir"
+exec 9>"$dir/.lock"
+flock 9
+todo="$(missing)"
+if [[ -n "$todo" ]]; then
+  echo "setup_npm_tools: installing $todo into $dir" >&2
+  [[ -f "$dir/package.json" ]] || echo '{ "name": "spherekit-npm-tools", "version": "0.0.0", "private": true }' >"$dir/package.json"
+  # shellcheck disable=SC2086  # $todo is a list of package specs
+  if ! (cd "$dir" && npm install --no-audit --no-fund --loglevel=error $todo >&2); then
+    echo "setup_npm_tools: npm install failed (is the npm registry reachable?)" >&2
+    exit 3
+  fi
+  todo="$(missing)"
+  if [[ -n "$todo" ]]; then
+    echo "setup_npm_tools: still missing after npm install: $todo" >&2
+    exit 3
+  fi
+fi
+echo "$dir"

@@ -1,0 +1,187 @@
+// Tests of the glTF levels of detail (convert/src/gltf_lods.cpp): every written primitive is
+// decoded in C++ (draco::Decoder, gltf_test_support) and compared with its accessors and with
+// the geometry image it came from; the MSFT_lod structure of the combined file.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+
+#include "cli_runner.h"
+#include "gltf_test_support.h"
+#include "spherekit/convert/gltf_lods.h"
+#include "test_paths.h"
+
+namespace fs = std::filesystem;
+using namespace spherekit;
+using namespace spherekit::convert;
+
+TEST_CASE("glTF LOD files: each Draco primitive decodes to its accessors and to its image's texels", "[convert]") {
+  const GeometryImage gi = test::lod_test_image();
+  const GltfLodOptions options = test::lod_test_options();
+  auto built = build_gltf_lods(gi, options);
+  REQUIRE(built.ok());
+  const GltfLods& lods = built.value();
+  REQUIRE(lods.levels.size() == 3);
+  const std::string dir = test::temp_dir("gltf_lods_files");
+  auto paths = write_gltf_lods(dir + "/blob", lods);
+  REQUIRE(paths.ok());
+  CHECK(paths->levels == std::vector<std::string>{dir + "/blob_lod0.glb", dir + "/blob_lod1.glb", dir + "/blob_lod2.glb"});
+  CHECK(paths->combined == dir + "/blob_lods.glb");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) ++files;
+  CHECK(files == 4);  // no temporary file left
+
+  const DracoQuantization& q = lods.quantization.quantization;
+  // The budget: 1e-4 RMS, a tenth of it for quantization.
+  CHECK(q.position_step() / 2 <= 1e-5);
+  CHECK(q.position_bits >= 14);
+  const double half_step = q.position_step() / 2, float_slack = 4 * 1.2e-7 * (q.position_range + 2);
+  const int T = gi.size;
+
+  std::map<int, Eigen::RowVector3f> level0_positions;  // texel -> decoded position in level 0
+  for (int k = 0; k < 3; ++k) {
+    INFO("level " << k);
+    const int n = (T - 1) / (1 << k) + 1, stride = 1 << k;
+    CHECK(lods.levels[static_cast<std::size_t>(k)].image_size == n);
+    const test::GlbFile glb = test::parse_glb(test::slurp(paths->levels[static_cast<std::size_t>(k)]));
+    CHECK(test::slurp(paths->levels[static_cast<std::size_t>(k)]) == lods.levels[static_cast<std::size_t>(k)].glb);
+    const auto& j = glb.json;
+    CHECK(j.at("asset").at("version") == "2.0");
+    CHECK(j.at("extensionsRequired") == nlohmann::json::array({"KHR_draco_mesh_compression"}));
+    CHECK(j.at("scenes").at(0).at("nodes") == nlohmann::json::array({0}));
+    CHECK(j.at("nodes").at(0).at("name") == "blob_LOD" + std::to_string(k));
+    // Quantization and provenance are recorded.
+    const auto& extras = j.at("meshes").at(0).at("extras").at("spherekit");
+    CHECK(extras.at("lod") == k);
+    CHECK(extras.at("geometry_image_size") == n);
+    CHECK(extras.at("texture_size") == T);
+    CHECK(extras.at("quantization").at("position_bits") == q.position_bits);
+    CHECK(extras.at("quantization").at("normal_bits") == 10);
+    CHECK(extras.at("quantization").at("budget").at("reference_rms_error").get<double>() == 1e-4);
+    CHECK(j.at("asset").at("extras").at("spherekit").at("source_mesh") == "blob.obj");
+
+    const auto decoded = test::decode_and_check_draco(glb);
+    REQUIRE(decoded.size() == 1);
+    const test::DecodedPrimitive& d = decoded[0];
+    CHECK(d.F.rows() == 2 * (n - 1) * (n - 1));
+    // Every point is a texel of this level (texture coordinates of the full image).
+    std::set<int> texels;
+    double worst = 0;
+    for (Eigen::Index p = 0; p < d.V.rows(); ++p) {
+      const int i = static_cast<int>(std::lround(d.UV(p, 1) * T - 0.5)), jj = static_cast<int>(std::lround(d.UV(p, 0) * T - 0.5));
+      REQUIRE(i % stride == 0);
+      REQUIRE(jj % stride == 0);
+      texels.insert(i * T + jj);
+      worst = std::max(worst, static_cast<double>((d.V.row(p) - gi.position(i, jj).transpose()).cwiseAbs().maxCoeff()));
+      if (k == 0) {
+        level0_positions[i * T + jj] = d.V.row(p);
+      } else {
+        // One grid for all levels: the texel decodes to the same position as in level 0.
+        REQUIRE(level0_positions.count(i * T + jj) == 1);
+        REQUIRE(level0_positions[i * T + jj] == d.V.row(p));
+      }
+    }
+    CHECK(texels.size() == static_cast<std::size_t>(n) * n);
+    CHECK(worst <= half_step + float_slack);
+  }
+}
+
+TEST_CASE("glTF LODs: the combined file's MSFT_lod structure", "[convert]") {
+  const GeometryImage gi = test::lod_test_image();
+  auto built = build_gltf_lods(gi, test::lod_test_options());
+  REQUIRE(built.ok());
+  const test::GlbFile glb = test::parse_glb(built->combined_glb);
+  const auto& j = glb.json;
+  // The scene shows only level 0, which lists the coarser levels (MSFT_lod README).
+  CHECK(j.at("scene") == 0);
+  CHECK(j.at("scenes").at(0).at("nodes") == nlohmann::json::array({0}));
+  REQUIRE(j.at("nodes").size() == 3);
+  REQUIRE(j.at("meshes").size() == 3);
+  for (int k = 0; k < 3; ++k) {
+    CHECK(j["nodes"][static_cast<std::size_t>(k)].at("mesh") == k);
+    CHECK(j["nodes"][static_cast<std::size_t>(k)].at("name") == "blob_LOD" + std::to_string(k));
+  }
+  const auto& top = j["nodes"][0];
+  CHECK(top.at("extensions").at("MSFT_lod").at("ids") == nlohmann::json::array({1, 2}));
+  CHECK_FALSE(j["nodes"][1].contains("extensions"));
+  const auto coverage = top.at("extras").at("MSFT_screencoverage").get<std::vector<double>>();
+  REQUIRE(coverage.size() == 3);
+  CHECK(coverage == std::vector<double>{0.5, 0.25, 0.0});
+  CHECK(coverage == built->screen_coverage);
+  const auto used = j.at("extensionsUsed").get<std::vector<std::string>>();
+  CHECK(std::count(used.begin(), used.end(), "MSFT_lod") == 1);
+  CHECK(std::count(used.begin(), used.end(), "KHR_draco_mesh_compression") == 1);
+  // Only Draco is required: a loader without MSFT_lod still loads the file (and shows level 0).
+  CHECK(j.at("extensionsRequired") == nlohmann::json::array({"KHR_draco_mesh_compression"}));
+
+  // Every level's bitstream is the one of its own file, and decodes to its accessors.
+  const auto decoded = test::decode_and_check_draco(glb);
+  REQUIRE(decoded.size() == 3);
+  for (int k = 0; k < 3; ++k) {
+    const auto& ext = j["meshes"][static_cast<std::size_t>(k)]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"];
+    CHECK(test::buffer_view_bytes(glb, ext.at("bufferView").get<int>()) ==
+          built->levels[static_cast<std::size_t>(k)].primitive.bytes);
+    CHECK(decoded[static_cast<std::size_t>(k)].V.rows() ==
+          built->levels[static_cast<std::size_t>(k)].primitive.decoded.mesh.V.rows());
+  }
+}
+
+TEST_CASE("glTF LODs: a collection gets one point order per level", "[convert]") {
+  // Consistent sphere maps give every member the same texels and faces; edgebreaker's traversal
+  // depends on connectivity and seams only, so the decoded point order (read through the
+  // texture coordinates) is the same for every member.
+  GltfLodOptions options = test::lod_test_options();
+  options.levels = 2;
+  auto a = build_gltf_lods(test::blob_geometry_image(33, 3, 7), options);
+  auto b = build_gltf_lods(test::blob_geometry_image(33, 3, 8), options);
+  REQUIRE(a.ok());
+  REQUIRE(b.ok());
+  for (std::size_t k = 0; k < 2; ++k) {
+    const GltfMesh& da = a->levels[k].primitive.decoded.mesh;
+    const GltfMesh& db = b->levels[k].primitive.decoded.mesh;
+    CHECK(da.UV == db.UV);
+    CHECK(da.F == db.F);
+  }
+}
+
+TEST_CASE("glTF LODs: errors and cancellation", "[convert]") {
+  const GeometryImage gi = test::blob_geometry_image(17);
+  GltfLodOptions options;
+  options.levels = 4;  // 17, 9, 5, 3
+  CHECK(build_gltf_lods(gi, options).ok());
+  options.levels = 5;  // would need a 2 x 2 level
+  CHECK(build_gltf_lods(gi, options).status().code() == ErrorCode::InvalidArgument);
+  options.levels = 0;
+  CHECK(build_gltf_lods(gi, options).status().code() == ErrorCode::InvalidArgument);
+  options = GltfLodOptions{};
+  options.lowest_coverage = 0.9;
+  CHECK(build_gltf_lods(gi, options).status().code() == ErrorCode::InvalidArgument);
+  CHECK(build_gltf_lods(GeometryImage{}, GltfLodOptions{}).status().code() == ErrorCode::InvalidArgument);
+
+  int calls = 0;
+  auto cancelled = build_gltf_lods(gi, GltfLodOptions{}, [&](const ProgressEvent& e) {
+    CHECK(e.stage == "gltf");
+    return ++calls < 2;
+  });
+  CHECK(cancelled.status().code() == ErrorCode::Cancelled);
+
+  // A single level: no MSFT_lod.
+  options = GltfLodOptions{};
+  options.levels = 1;
+  auto one = build_gltf_lods(gi, options);
+  REQUIRE(one.ok());
+  const auto j = test::parse_glb(one->combined_glb).json;
+  CHECK_FALSE(j.at("nodes").at(0).contains("extensions"));
+  CHECK(j.at("extensionsUsed") == nlohmann::json::array({"KHR_draco_mesh_compression"}));
+
+  // Unwritable folder: IoError naming the file.
+  auto lods = build_gltf_lods(gi, GltfLodOptions{});
+  REQUIRE(lods.ok());
+  const std::string dir = test::temp_dir("gltf_lods_errors");
+  auto w = write_gltf_lods(dir + "/no/such/folder/x", lods.value());
+  CHECK(w.status().code() == ErrorCode::IoError);
+  CHECK(w.status().message().find("x_lod0.glb") != std::string::npos);
+}

@@ -1,0 +1,96 @@
+// Every .glb the glTF tests write passes the Khronos glTF validator with 0 errors and 0
+// warnings and decodes with Google's draco3d (npm), both installed on first use by
+// scripts/setup_npm_tools.sh. Skips with a message when node/npm or the registry is missing.
+//
+// The files are rebuilt here from the same fixtures the other tests use (gltf_test_support.h),
+// because each test case runs as its own process. Infos the validator reports and that are
+// expected: UNSUPPORTED_EXTENSION (it cannot check Draco or MSFT_lod payloads) and
+// UNUSED_OBJECT (the Draco bitstream views, the MSFT_lod levels reachable only through "ids",
+// TEXCOORD_0 while no material samples a texture: the texture is the user's to add).
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+#include "cli_runner.h"
+#include "gltf_test_support.h"
+#include "spherekit/convert/gltf_lods.h"
+#include "spherekit/convert/gltf_morph.h"
+#include "spherekit/formats/atomic_file.h"
+#include "test_meshes.h"
+#include "test_paths.h"
+
+using namespace spherekit;
+using namespace spherekit::convert;
+
+TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[convert][npm]") {
+  const test::NpmTools& tools = test::npm_tools();
+  if (!tools.available) {
+    WARN("SKIPPED: the npm validators are unavailable (scripts/setup_npm_tools.sh said: " << tools.why << ")");
+    return;
+  }
+  const std::string dir = test::temp_dir("gltf_validator");
+  std::vector<std::string> files;
+  auto write = [&](const std::string& name, const std::string& bytes) {
+    REQUIRE(formats::write_file_atomic(dir + "/" + name, bytes).ok());
+    files.push_back(dir + "/" + name);
+  };
+
+  // gltf_lods_test: the levels, the MSFT_lod file, a single level.
+  auto lods = build_gltf_lods(test::lod_test_image(), test::lod_test_options());
+  REQUIRE(lods.ok());
+  auto paths = write_gltf_lods(dir + "/blob", lods.value());
+  REQUIRE(paths.ok());
+  files.insert(files.end(), paths->levels.begin(), paths->levels.end());
+  files.push_back(paths->combined);
+  GltfLodOptions one = test::lod_test_options();
+  one.levels = 1;
+  auto single = build_gltf_lods(test::blob_geometry_image(17), one);
+  REQUIRE(single.ok());
+  write("single_lods.glb", single->combined_glb);
+
+  // gltf_morph_test: uncompressed, Draco sequential, from triangle meshes.
+  const std::vector<GltfMesh> members = test::collection_test_meshes(17);
+  auto plain = build_gltf_morph_targets(members);
+  REQUIRE(plain.ok());
+  write("morph_plain.glb", plain->glb);
+  GltfMorphOptions draco;
+  draco.encoding = MorphEncoding::DracoSequential;
+  auto compressed = build_gltf_morph_targets(members, draco);
+  REQUIRE(compressed.ok());
+  write("morph_draco.glb", compressed->glb);
+  auto trimeshes = build_gltf_morph_targets(std::vector<TriMesh>{test::random_blob(2, 1), test::random_blob(2, 2)});
+  REQUIRE(trimeshes.ok());
+  write("morph_trimesh.glb", trimeshes->glb);
+  auto lone = build_gltf_morph_targets(std::vector<TriMesh>{test::random_blob(2, 1)});
+  REQUIRE(lone.ok());
+  write("morph_single.glb", lone->glb);
+
+#ifdef SPHEREKIT_EXE
+  // gltf_cli_test: what `spherekit convert --lods` writes.
+  test::write_blob_inputs(dir);
+  const test::CliRun r = test::run_cli(SPHEREKIT_EXE,
+                                       "convert " + test::shell_quote(dir + "/blob.obj") + " " +
+                                           test::shell_quote(dir + "/blob.sphere.obj") + " -o " +
+                                           test::shell_quote(dir + "/cli.exr") + " --gi 33 --lods 3 --psnr-samples 0",
+                                       test::temp_dir("gltf_validator_capture"));
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  for (const char* name : {"cli_lod0.glb", "cli_lod1.glb", "cli_lod2.glb", "cli_lods.glb"}) files.push_back(dir + "/" + name);
+#endif
+
+  const nlohmann::json report = test::run_npm_validators(tools, files);
+  REQUIRE(report.at("files").size() == files.size());
+  for (const auto& f : report["files"]) {
+    INFO(f.dump(1));
+    CHECK(f.at("errors") == 0);
+    CHECK(f.at("warnings") == 0);
+    CHECK(f.at("draco_problems").empty());
+    const std::string name = f.at("file");
+    // Every file but the uncompressed morph targets has Draco primitives, all decoded.
+    const bool uncompressed = name.find("morph_plain") != std::string::npos ||
+                              name.find("morph_trimesh") != std::string::npos ||
+                              name.find("morph_single") != std::string::npos;
+    CHECK((f.at("draco_primitives").get<int>() > 0) == !uncompressed);
+  }
+}

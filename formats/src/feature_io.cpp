@@ -1,16 +1,20 @@
-// Landmark files (`name vertex_index`) and sphere-point files (`name x y z`): one record per
-// line, '#' comments, blank lines ignored. Every problem is reported as "file:line: ...".
+// Landmark files (`name vertex_index`), sphere-point files (`name x y z`) and landmark
+// targets (`name vertex_index x y z`): one record per line, '#' comments, blank lines
+// ignored. Every problem is reported as "file:line: ...".
 #include "spherekit/formats/feature_io.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <string_view>
 #include <vector>
 
+#include "feature_codecs.h"
 #include "number_text.h"
 #include "spherekit/formats/atomic_file.h"
 #include "text_scan.h"
+#include "unit_vector.h"
 
 namespace spherekit::formats {
 namespace {
@@ -19,7 +23,7 @@ using detail::quote_token;
 
 /// Splits a content line into at most `kMaxFields` tokens and counts all of them.
 struct Fields {
-  static constexpr int kMaxFields = 4;
+  static constexpr int kMaxFields = 5;
   std::string_view token[kMaxFields];
   int count = 0;
 };
@@ -43,6 +47,13 @@ bool writable_name(const std::string& name) {
   return true;
 }
 
+/// A vector length for a message: "2", "0.5", "1e+303" (to_string would print 300 digits).
+std::string length_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
 Status bad_name(const std::string& path, const std::string& name) {
   return Status(ErrorCode::InvalidInput, path + ": cannot write name " + quote_token(name) +
                                              " (names must be non-empty, without spaces or '#')");
@@ -50,8 +61,9 @@ Status bad_name(const std::string& path, const std::string& name) {
 
 }  // namespace
 
-Result<std::vector<Landmark>> read_landmarks(const std::string& path, int num_vertices) {
-  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
+namespace detail {
+
+Result<std::vector<Landmark>> parse_landmarks(const std::string& path, std::string_view bytes, int num_vertices) {
   detail::LineReader lines(bytes);
   std::vector<Landmark> landmarks;
   std::map<std::string, std::uint64_t, std::less<>> name_line;    // name -> line of first use
@@ -96,6 +108,13 @@ Result<std::vector<Landmark>> read_landmarks(const std::string& path, int num_ve
   return landmarks;
 }
 
+}  // namespace detail
+
+Result<std::vector<Landmark>> read_landmarks(const std::string& path, int num_vertices) {
+  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
+  return detail::parse_landmarks(path, bytes, num_vertices);
+}
+
 Status write_landmarks(const std::string& path, const std::vector<Landmark>& landmarks) {
   std::string out = "# landmarks: name vertex_index (0-based)\n";
   for (const Landmark& l : landmarks) {
@@ -112,12 +131,14 @@ Status write_landmarks(const std::string& path, const std::vector<Landmark>& lan
   return write_file_atomic(path, out);
 }
 
-Result<std::vector<SpherePoint>> read_sphere_points(const std::string& path, bool require_unit) {
+namespace detail {
+
+Result<std::vector<SpherePoint>> parse_sphere_points(const std::string& path, std::string_view bytes,
+                                                     bool require_unit) {
   // Points are unit to within writing precision; only |p| further than this from 1 is
   // worth dividing out, so points written exactly come back bit-identical.
   constexpr double kUnitRoundoff = 4 * std::numeric_limits<double>::epsilon();
   constexpr double kRequireUnitTolerance = 1e-6;  // the documented contract of require_unit
-  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
   detail::LineReader lines(bytes);
   std::vector<SpherePoint> points;
   std::map<std::string, std::uint64_t, std::less<>> name_line;
@@ -139,13 +160,13 @@ Result<std::vector<SpherePoint>> read_sphere_points(const std::string& path, boo
     if (!sp.p.allFinite()) {
       return Status(ErrorCode::InvalidInput, at + "point " + quote_token(sp.name) + " is not finite");
     }
-    const double norm = sp.p.norm();
+    const double norm = sp.p.stableNorm();  // finite for every finite point
     if (norm == 0) return Status(ErrorCode::InvalidInput, at + "point " + quote_token(sp.name) + " has zero length");
     if (require_unit && std::abs(norm - 1) > kRequireUnitTolerance) {
       return Status(ErrorCode::InvalidInput, at + "point " + quote_token(sp.name) + " has length " +
-                                                 std::to_string(norm) + ", not 1");
+                                                 length_text(norm) + ", not 1");
     }
-    if (std::abs(norm - 1) > kUnitRoundoff) sp.p /= norm;
+    if (std::abs(norm - 1) > kUnitRoundoff) sp.p = detail::unit_vector(sp.p);
     if (auto it = name_line.find(sp.name); it != name_line.end()) {
       return Status(ErrorCode::InvalidInput, at + "duplicate point name " + quote_token(sp.name) + " (first on line " +
                                                  std::to_string(it->second) + ")");
@@ -154,6 +175,80 @@ Result<std::vector<SpherePoint>> read_sphere_points(const std::string& path, boo
     points.push_back(std::move(sp));
   }
   return points;
+}
+
+}  // namespace detail
+
+Result<std::vector<SpherePoint>> read_sphere_points(const std::string& path, bool require_unit) {
+  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
+  return detail::parse_sphere_points(path, bytes, require_unit);
+}
+
+namespace detail {
+
+Result<std::vector<LandmarkTarget>> parse_landmark_targets(const std::string& path, std::string_view bytes,
+                                                           int num_vertices) {
+  detail::LineReader lines(bytes);
+  std::vector<LandmarkTarget> targets;
+  std::map<std::string, std::uint64_t, std::less<>> name_line;  // name -> line of first use
+  std::map<int, std::uint64_t> vertex_line;                     // vertex -> line of first use
+  std::string_view line;
+  while (lines.next(line)) {
+    const std::string at = path + ":" + std::to_string(lines.number()) + ": ";
+    const Fields f = split_fields(detail::strip_comment(line));
+    if (f.count == 0) continue;
+    if (f.count != 5) {
+      return Status(ErrorCode::ParseError,
+                    at + "expected 'name vertex_index x y z', got " + std::to_string(f.count) + " fields");
+    }
+    LandmarkTarget t;
+    t.name = std::string(f.token[0]);
+    std::int64_t index = 0;
+    if (!detail::parse_int(f.token[1], index)) {
+      return Status(ErrorCode::ParseError, at + "vertex index " + quote_token(f.token[1]) + " is not an integer");
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (!detail::parse_double(f.token[k + 2], t.p[k])) {
+        return Status(ErrorCode::ParseError, at + "bad number " + quote_token(f.token[k + 2]));
+      }
+    }
+    if (index < 0) return Status(ErrorCode::InvalidInput, at + "negative vertex index " + std::to_string(index));
+    if ((num_vertices >= 0 && index >= num_vertices) || index > std::numeric_limits<int>::max()) {
+      return Status(ErrorCode::InvalidInput, at + "vertex index " + std::to_string(index) + " out of range (" +
+                                                 (num_vertices >= 0 ? std::to_string(num_vertices) : "int") +
+                                                 (num_vertices >= 0 ? " vertices)" : " range)"));
+    }
+    t.vertex = static_cast<int>(index);
+    if (!t.p.allFinite()) {
+      return Status(ErrorCode::InvalidInput, at + "target " + quote_token(t.name) + " is not finite");
+    }
+    const double norm = t.p.stableNorm();  // finite for every finite point
+    if (std::abs(norm - 1) > kTargetUnitTolerance) {
+      return Status(ErrorCode::InvalidInput, at + "target " + quote_token(t.name) + " has length " +
+                                                 length_text(norm) + ", not 1 (targets are points on the unit sphere)");
+    }
+    t.p /= norm;  // in [1 - 1e-3, 1 + 1e-3]: no overflow or underflow
+    if (auto it = name_line.find(t.name); it != name_line.end()) {
+      return Status(ErrorCode::InvalidInput, at + "duplicate target name " + quote_token(t.name) + " (first on line " +
+                                                 std::to_string(it->second) + ")");
+    }
+    if (auto it = vertex_line.find(t.vertex); it != vertex_line.end()) {
+      return Status(ErrorCode::InvalidInput, at + "target " + quote_token(t.name) + " uses vertex " +
+                                                 std::to_string(t.vertex) + ", already targeted on line " +
+                                                 std::to_string(it->second));
+    }
+    name_line.emplace(t.name, lines.number());
+    vertex_line.emplace(t.vertex, lines.number());
+    targets.push_back(std::move(t));
+  }
+  return targets;
+}
+
+}  // namespace detail
+
+Result<std::vector<LandmarkTarget>> read_landmark_targets(const std::string& path, int num_vertices) {
+  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
+  return detail::parse_landmark_targets(path, bytes, num_vertices);
 }
 
 Status write_sphere_points(const std::string& path, const std::vector<SpherePoint>& points) {

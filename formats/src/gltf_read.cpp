@@ -404,9 +404,21 @@ class GltfReader {
           fail(ErrorCode::Unsupported, path_ + ": " + name + ": uri " + quote_token(uri) + " is not a local file");
         }
         const std::filesystem::path file = std::filesystem::path(path_).parent_path() / percent_decode(uri);
+        // Only regular files: read_file reads to the end, which never comes for a uri naming
+        // /dev/zero or a FIFO (a hostile file would hang the reader or exhaust memory).
+        std::error_code ec;
+        const std::filesystem::file_status st = std::filesystem::status(file, ec);
+        if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st)) {
+          fail(ErrorCode::InvalidInput, path_ + ": " + name + ": uri " + quote_token(uri) + " is not a regular file");
+        }
         Result<std::string> bytes = read_file(file.string());
-        // The read_file message names the buffer file and why it could not be read.
-        if (!bytes.ok()) fail(ErrorCode::IoError, path_ + ": " + name + ": " + bytes.status().message());
+        if (!bytes.ok()) {
+          // read_file's message is "<file>: why". The file name comes from the document and
+          // may hold anything (a newline would break the one-line message): quote the uri.
+          std::string why = bytes.status().message();
+          if (why.rfind(file.string() + ": ", 0) == 0) why.erase(0, file.string().size() + 2);
+          fail(ErrorCode::IoError, path_ + ": " + name + ": uri " + quote_token(uri) + ": " + one_line(why));
+        }
         out.owned = std::move(bytes).value();
       }
       out.view = out.owned;

@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "spherekit/formats/mesh_io.h"
+#include "spherekit/sphere_map.h"
 
 namespace spherekit::formats::detail {
 
@@ -22,6 +23,9 @@ Result<TriMesh> read_gltf(const std::string& path, std::string_view bytes, bool 
 /// Parses a mesh file already in memory, choosing the reader by the extension of `path`.
 Result<TriMesh> parse_mesh(const std::string& path, std::string_view bytes, const ReadOptions& options,
                            ReadInfo* info);
+
+/// Parses a sphere map already in memory (read_sphere_map without the file read).
+Result<SphereMap> parse_sphere_map(const std::string& path, std::string_view bytes, const TriMesh& mesh);
 
 /// OBJ text: `header` (already '#'-commented lines) first, then `v` lines and 1-based `f` lines.
 std::string format_obj(const TriMesh& mesh, int precision, const std::string& header);

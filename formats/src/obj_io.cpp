@@ -22,6 +22,11 @@ std::string at_line(const std::string& path, std::uint64_t line) {
 Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const ReadOptions& options,
                          ReadInfo& info) {
   info.format = "obj";
+  // OBJ readers skip statements they do not know, so a binary file (or UTF-16 text) would
+  // otherwise end as a puzzling "no faces".
+  if (const std::size_t nul = bytes.find('\0'); nul != std::string_view::npos) {
+    return Status(ErrorCode::ParseError, path + ": not a text file (NUL byte at offset " + std::to_string(nul) + ")");
+  }
   MeshBuilder builder(path, options.polygons, /*index_base=*/1);
   // A typical OBJ spends ~30 bytes per vertex line and ~2 face lines per vertex; this avoids
   // most regrowth without trusting anything the file claims.

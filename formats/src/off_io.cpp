@@ -74,7 +74,8 @@ Result<TriMesh> read_off(const std::string& path, std::string_view bytes, const 
   for (std::uint64_t i = 0; i < nv; ++i) {
     if (!next_content(lines, content)) {
       return Status(ErrorCode::ParseError, path + ": OFF ends after " + std::to_string(i) + " of " +
-                                               std::to_string(nv) + " vertices");
+                                               std::to_string(nv) +
+                                               " vertices (truncated, or wrong counts in the header?)");
     }
     rest = content;
     double xyz[3];
@@ -89,7 +90,8 @@ Result<TriMesh> read_off(const std::string& path, std::string_view bytes, const 
   for (std::uint64_t i = 0; i < nf; ++i) {
     if (!next_content(lines, content)) {
       return Status(ErrorCode::ParseError, path + ": OFF ends after " + std::to_string(i) + " of " +
-                                               std::to_string(nf) + " faces");
+                                               std::to_string(nf) +
+                                               " faces (truncated, or wrong counts in the header?)");
     }
     rest = content;
     std::int64_t n = 0;

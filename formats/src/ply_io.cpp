@@ -141,6 +141,8 @@ Result<PlyHeader> parse_header(const std::string& path, std::string_view bytes) 
       }
       header.elements.back().properties.push_back(std::move(p));
     } else {
+      double number = 0;
+      if (parse_double(token, number)) return error("PLY header has no end_header line before the data");
       return error("unknown PLY header line " + quote_token(token));
     }
   }
@@ -240,6 +242,8 @@ class AsciiSource {
   }
   bool has_trailing_data() { return tokens_.next(last_); }
   std::uint64_t line() const { return tokens_.line() + line_offset_; }
+  /// Whether the element just read ended its line (see read_body's `misaligned`).
+  bool element_ends_line() const { return tokens_.rest_of_line_blank(); }
 
  private:
   TokenReader tokens_;
@@ -261,9 +265,18 @@ std::size_t min_element_size(const PlyElement& e, bool binary) {
   return size;
 }
 
+/// Ascii PLY writers put one element per line. The first element that does not end its line
+/// is remembered: when reading then fails, a header whose counts or properties do not match
+/// the data is the likely cause, and the place where the two part ways is the useful thing to
+/// report (the failure itself shows up elements later, as something unrelated).
+struct Misalignment {
+  bool seen = false;
+  std::string message;
+};
+
 template <class Source>
 Status read_body(const std::string& path, const PlyHeader& header, const char* kind, Source& src,
-                 MeshBuilder& builder) {
+                 MeshBuilder& builder, Misalignment& misaligned) {
   std::vector<std::int64_t> corners;
   std::vector<Role> roles;
   for (const PlyElement& e : header.elements) {
@@ -312,9 +325,18 @@ Status read_body(const std::string& path, const PlyHeader& header, const char* k
         }
         if (r == ReadResult::End) {
           return Status(ErrorCode::ParseError, path + ": " + kind + " PLY ends after " + std::to_string(i) +
-                                                   " of " + std::to_string(e.count) + " " + plural(e));
+                                                   " of " + std::to_string(e.count) + " " + plural(e) +
+                                                   " (truncated, or wrong counts in the header?)");
         }
         if (r == ReadResult::Bad) return Status(ErrorCode::ParseError, src.bad_message(path));
+      }
+      if constexpr (!Source::kBinary) {
+        if (!misaligned.seen && !src.element_ends_line()) {
+          misaligned.seen = true;
+          misaligned.message = path + ":" + std::to_string(src.line()) + ": " + e.name + " " + std::to_string(i) +
+                               " does not end its line: the data does not match the header (wrong counts or "
+                               "properties?)";
+        }
       }
       if (is_vertex) SPHEREKIT_RETURN_IF_ERROR(builder.add_vertex(xyz[0], xyz[1], xyz[2]));
       if (is_face) SPHEREKIT_RETURN_IF_ERROR(builder.add_face(corners.data(), corners.size(), FaceSource::element(i)));
@@ -358,16 +380,19 @@ Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const 
   if (header.format == PlyFormat::Ascii) {
     info.format = "ply-ascii";
     AsciiSource src(body, header.body_line);
-    SPHEREKIT_RETURN_IF_ERROR(read_body(path, header, "ascii", src, builder));
-    if (src.has_trailing_data()) {
-      return Status(ErrorCode::ParseError, path + ":" + std::to_string(src.line()) +
+    Misalignment misaligned;
+    Status read = read_body(path, header, "ascii", src, builder, misaligned);
+    if (read.ok() && src.has_trailing_data()) {
+      read = Status(ErrorCode::ParseError, path + ":" + std::to_string(src.line()) +
                                                ": data after the last element (wrong counts in header?)");
     }
+    if (!read.ok()) return misaligned.seen ? Status(ErrorCode::ParseError, misaligned.message) : read;
   } else {
     const bool big = header.format == PlyFormat::BinaryBE;
     info.format = big ? "ply-binary-be" : "ply-binary-le";
     BinarySource src(body, big);
-    SPHEREKIT_RETURN_IF_ERROR(read_body(path, header, "binary", src, builder));
+    Misalignment unused;  // binary data has no lines
+    SPHEREKIT_RETURN_IF_ERROR(read_body(path, header, "binary", src, builder, unused));
     if (std::size_t extra = src.trailing_data(body)) {
       return Status(ErrorCode::ParseError, path + ": binary PLY has " + std::to_string(extra) +
                                                " bytes after the last element (wrong counts in header?)");

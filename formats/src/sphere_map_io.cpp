@@ -17,6 +17,7 @@
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/version.h"
 #include "text_scan.h"
+#include "unit_vector.h"
 
 namespace spherekit::formats {
 namespace {
@@ -102,11 +103,12 @@ Status write_sphere_map(const std::string& path, const TriMesh& mesh, const Sphe
   return write_file_atomic(path, detail::format_obj(sphere, 17, header));
 }
 
-Result<SphereMap> read_sphere_map(const std::string& path, const TriMesh& mesh) {
+namespace detail {
+
+Result<SphereMap> parse_sphere_map(const std::string& path, std::string_view bytes, const TriMesh& mesh) {
   // Unit to within writing precision: dividing by such a norm would only perturb the last
   // bits, so exactly written maps are returned bit-identical.
   constexpr double kUnitRoundoff = 4 * std::numeric_limits<double>::epsilon();
-  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
   SPHEREKIT_ASSIGN_OR_RETURN(TriMesh points, detail::parse_mesh(path, bytes, ReadOptions{}, nullptr));
   if (points.V.rows() != mesh.V.rows()) {
     return Status(ErrorCode::InvalidInput, path + ": has " + std::to_string(points.V.rows()) + " vertices, mesh has " +
@@ -115,18 +117,25 @@ Result<SphereMap> read_sphere_map(const std::string& path, const TriMesh& mesh) 
   SphereMap map;
   map.S = std::move(points.V);
   for (Eigen::Index i = 0; i < map.S.rows(); ++i) {
-    const double norm = map.S.row(i).stableNorm();  // no overflow for large finite values
-    // parse_mesh has rejected NaN/Inf already; only |p| near DBL_MAX * sqrt(3) gets here.
-    if (!std::isfinite(norm)) {
-      return Status(ErrorCode::InvalidInput, path + ": point " + std::to_string(i) + " is not finite");
-    }
+    // parse_mesh has rejected NaN/Inf. The norm is only a test here (inf for finite points
+    // near DBL_MAX * sqrt(3)); unit_vector normalises without overflow or underflow.
+    const double norm = map.S.row(i).stableNorm();
     if (norm == 0) {
       return Status(ErrorCode::InvalidInput, path + ": point " + std::to_string(i) + " is zero (not on the sphere)");
     }
-    if (std::abs(norm - 1) > kUnitRoundoff) map.S.row(i) /= norm;
+    if (!(std::abs(norm - 1) <= kUnitRoundoff)) {
+      map.S.row(i) = detail::unit_vector(map.S.row(i).transpose()).transpose();
+    }
   }
   if (file_extension(path) == "obj") SPHEREKIT_RETURN_IF_ERROR(parse_provenance(path, bytes, map.provenance));
   return map;
+}
+
+}  // namespace detail
+
+Result<SphereMap> read_sphere_map(const std::string& path, const TriMesh& mesh) {
+  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, read_file(path));
+  return detail::parse_sphere_map(path, bytes, mesh);
 }
 
 }  // namespace spherekit::formats

@@ -178,6 +178,14 @@ class TokenReader {
   void skip_line() {
     while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
   }
+  /// True if only blanks are left before the next line break (or the end of the text): the
+  /// last token returned ended its line.
+  bool rest_of_line_blank() const {
+    for (std::size_t i = pos_; i < text_.size() && text_[i] != '\n'; ++i) {
+      if (!is_blank(text_[i])) return false;
+    }
+    return true;
+  }
   /// 1-based line of the last token returned.
   std::uint64_t line() const { return line_; }
   std::size_t remaining_bytes() const { return pos_ >= text_.size() ? 0 : text_.size() - pos_; }

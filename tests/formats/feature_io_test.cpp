@@ -142,6 +142,61 @@ TEST_CASE("sphere points: exact round trip and normalisation", "[formats]") {
   check_error(read_sphere_points(loose, true), ErrorCode::InvalidInput, loose, 2, "length 2");
 }
 
+TEST_CASE("sphere points: huge and subnormal points become unit vectors", "[formats]") {
+  // Fuzzing finding (fuzz_sphere_points): |p|^2 overflowed for p = (1e303, 0, 999999), so the
+  // point was divided by inf and returned as the zero vector; subnormal points lost their
+  // precision in |p|. Both must come back as unit vectors pointing the same way.
+  const std::string dir = test::temp_dir("formats_sphere_points_range");
+  const std::string path =
+      write_file(dir, "range.txt", "big 1e303 0 999999\nhuge 1.7e308 -1.7e308 1.7e308\ntiny 1e-320 1e-320 0\n");
+  for (bool require_unit : {false, true}) {
+    Result<std::vector<SpherePoint>> r = read_sphere_points(path, require_unit);
+    if (require_unit) {
+      check_error(r, ErrorCode::InvalidInput, path, 1, "has length 1e+303, not 1");
+      continue;
+    }
+    REQUIRE(r.ok());
+    REQUIRE(r->size() == 3);
+    for (const SpherePoint& p : *r) {
+      INFO(p.name);
+      CHECK(std::abs(p.p.norm() - 1) < 1e-15);
+    }
+    CHECK((*r)[0].p.x() == 1.0);
+    CHECK(((*r)[1].p - Eigen::Vector3d(1, -1, 1) / std::sqrt(3.0)).norm() < 1e-15);
+    CHECK(((*r)[2].p - Eigen::Vector3d(1, 1, 0) / std::sqrt(2.0)).norm() < 1e-3);  // the input has few bits
+  }
+}
+
+TEST_CASE("landmark targets: unit vectors, ranges and duplicates", "[formats]") {
+  const std::string dir = test::temp_dir("formats_landmark_targets");
+  const std::string good = write_file(dir, "t.txt", "# name vertex x y z\nnose 3 0 0 1\ntail 0 0.577 0.577 0.577\n");
+  Result<std::vector<formats::LandmarkTarget>> r = read_landmark_targets(good, 4);
+  REQUIRE(r.ok());
+  REQUIRE(r->size() == 2);
+  CHECK((*r)[0].name == "nose");
+  CHECK((*r)[0].vertex == 3);
+  CHECK((*r)[0].p == Eigen::Vector3d(0, 0, 1));
+  CHECK(std::abs((*r)[1].p.norm() - 1) < 1e-15);  // 3-decimal input within kTargetUnitTolerance
+
+  const std::string path = dir + "/b.txt";
+  auto read = [&](const std::string& bad, int num_vertices = 4) {
+    return read_landmark_targets(write_file(dir, "b.txt", "a 0 1 0 0\n" + bad + "\n"), num_vertices);
+  };
+  check_error(read("b 1 0 1"), ErrorCode::ParseError, path, 2, "got 4 fields");
+  check_error(read("b one 0 1 0"), ErrorCode::ParseError, path, 2, "is not an integer");
+  check_error(read("b 1 0 x 0"), ErrorCode::ParseError, path, 2, "bad number 'x'");
+  check_error(read("b -1 0 1 0"), ErrorCode::InvalidInput, path, 2, "negative vertex index -1");
+  check_error(read("b 4 0 1 0"), ErrorCode::InvalidInput, path, 2, "out of range (4 vertices)");
+  check_error(read("b 99999999999 0 1 0", -1), ErrorCode::InvalidInput, path, 2, "out of range");
+  check_error(read("b 1 nan 1 0"), ErrorCode::InvalidInput, path, 2, "not finite");
+  check_error(read("b 1 0 2 0"), ErrorCode::InvalidInput, path, 2, "has length 2, not 1");
+  check_error(read("b 1 0 0.99 0"), ErrorCode::InvalidInput, path, 2, "has length 0.99, not 1");
+  check_error(read("b 1 1e303 0 0"), ErrorCode::InvalidInput, path, 2, "has length 1e+303, not 1");
+  check_error(read("b 1 0 0 0"), ErrorCode::InvalidInput, path, 2, "has length 0, not 1");
+  check_error(read("a 1 0 1 0"), ErrorCode::InvalidInput, path, 2, "duplicate target name 'a'");
+  check_error(read("b 0 0 1 0"), ErrorCode::InvalidInput, path, 2, "uses vertex 0, already targeted on line 1");
+}
+
 TEST_CASE("sphere points: rejected lines name file and line", "[formats]") {
   const std::string dir = test::temp_dir("formats_sphere_points_errors");
   const std::string path = dir + "/s.txt";

@@ -2,6 +2,7 @@
 #include "spherekit/formats/sphere_map_io.h"
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -77,6 +78,32 @@ TEST_CASE("sphere map: any mesh format, normalised, without provenance", "[forma
   CHECK((back->S - mesh.V).cwiseAbs().maxCoeff() < 1e-15);
   CHECK(back->provenance.method.empty());
   CHECK(back->provenance.seed == 0);
+}
+
+TEST_CASE("sphere map: points of any finite, non-zero length normalise exactly", "[formats]") {
+  // Fuzzing finding (fuzz_sphere_points; the same normalisation was here): |p|^2 overflowed
+  // for huge points, which came back as (0, 0, 0) or were refused as "not finite"; subnormal
+  // points lost their precision in |p|.
+  const std::string dir = test::temp_dir("formats_sphere_map_range");
+  const TriMesh mesh = test::octahedron();  // its vertices are the unit axes
+  for (double scale : {1e303, 1.7e308, 1e-320, 4.9e-324}) {
+    INFO("scale " << scale);
+    TriMesh scaled = mesh;
+    scaled.V *= scale;
+    const std::string path = dir + "/map.ply";
+    REQUIRE(write_mesh(path, scaled).ok());
+    Result<SphereMap> back = read_sphere_map(path, mesh);
+    REQUIRE(back.ok());
+    CHECK(back->S == mesh.V);
+  }
+  RowMat3d diagonal(1, 3);
+  diagonal << 1.7e308, -1.7e308, 1.7e308;
+  TriMesh one{diagonal, RowMat3i()};
+  const std::string path = dir + "/diagonal.obj";
+  REQUIRE(write_file_atomic(path, "v 1.7e308 -1.7e308 1.7e308\nf 1 1 1\n").ok());
+  Result<SphereMap> back = read_sphere_map(path, one);
+  REQUIRE(back.ok());
+  CHECK((back->S.row(0) - Eigen::RowVector3d(1, -1, 1) / std::sqrt(3.0)).norm() < 1e-15);
 }
 
 TEST_CASE("sphere map: rejections", "[formats]") {

@@ -278,9 +278,44 @@ Result<LoadedMesh> load_mesh_checked(const std::string& path, bool allow_boundar
     m.check = check_mesh(m.mesh);
     m.check_seconds += t.seconds();
   }
-  Status verdict = require_genus0(m.check, allow_boundary);
-  if (!verdict.ok()) return with_file(verdict, path);
+  Status verdict = param_verdict(m, allow_boundary);
+  if (!verdict.ok()) return verdict;
   return loaded;
+}
+
+Status require_supported_coordinates(const TriMesh& mesh, const std::string& path) {
+  if (mesh.V.rows() == 0) return Status::ok_status();
+  const double largest = mesh.V.cwiseAbs().maxCoeff();
+  if (!(largest <= kMaxCoordinate))
+    return Status(ErrorCode::InvalidInput,
+                  strprintf("%s: coordinates reach %.3g, beyond the supported |x| <= %.0e (lengths, areas and "
+                            "stretch would overflow); scale the mesh down",
+                            path.c_str(), largest, kMaxCoordinate));
+  // No overflow below kMaxCoordinate: the diagonal is at most 2 sqrt(3) kMaxCoordinate.
+  const double extent = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
+  if (extent == 0) return Status(ErrorCode::InvalidInput, path + ": all vertices are at one point (zero extent)");
+  if (extent < kMinExtent)
+    return Status(ErrorCode::InvalidInput,
+                  strprintf("%s: the mesh is %.3g across, below the supported %.0e (areas and stretch would "
+                            "underflow); scale the mesh up",
+                            path.c_str(), extent, kMinExtent));
+  return Status::ok_status();
+}
+
+Status param_verdict(const LoadedMesh& m, bool allow_boundary) {
+  SPHEREKIT_RETURN_IF_ERROR(with_file(require_genus0(m.check, allow_boundary), m.path));
+  return require_supported_coordinates(m.mesh, m.path);
+}
+
+Status require_output_folders(const std::vector<std::string>& paths) {
+  for (const std::string& path : paths) {
+    if (path.empty()) continue;
+    const fs::path parent = fs::path(path).parent_path();
+    std::error_code ec;
+    if (!parent.empty() && !fs::is_directory(parent, ec))
+      return Status(ErrorCode::IoError, path + ": folder '" + parent.string() + "' does not exist");
+  }
+  return Status::ok_status();
 }
 
 Json mesh_check_json(const std::string& file, const MeshCheck& c) {

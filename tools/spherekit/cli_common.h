@@ -181,10 +181,31 @@ struct LoadedMesh {
 /// with the file path.
 Result<LoadedMesh> load_mesh(const std::string& path);
 
+/// Coordinates the commands accept: every |x| <= kMaxCoordinate and a bounding-box diagonal
+/// >= kMinExtent. Beyond these, squared lengths, cross products and areas of the mesh overflow
+/// or underflow in double precision (|x| = 1e300 makes every area inf, 1e-100 makes it 0), so
+/// stretch and quality numbers come out NaN or 0 while everything else looks fine. 1e50
+/// leaves room for the 4th and higher powers of lengths the stretch computation forms.
+inline constexpr double kMaxCoordinate = 1e50;
+inline constexpr double kMinExtent = 1e-50;
+
+/// InvalidInput naming `path` if the mesh's coordinates are outside the range above (or all
+/// vertices coincide); Ok otherwise. Coordinates must be finite (the readers ensure it).
+Status require_supported_coordinates(const TriMesh& mesh, const std::string& path);
+
+/// What `param` accepts, as one verdict: require_genus0 (holes allowed if `allow_boundary`),
+/// then require_supported_coordinates. The message starts with the file path.
+Status param_verdict(const LoadedMesh& mesh, bool allow_boundary);
+
 /// Reads a mesh, optionally splits pinched vertices, checks it and refuses anything the
-/// parameterizer cannot handle (require_genus0). `allow_boundary`: holes are acceptable.
+/// parameterizer cannot handle (param_verdict). `allow_boundary`: holes are acceptable.
 /// The error message starts with the file path.
 Result<LoadedMesh> load_mesh_checked(const std::string& path, bool allow_boundary, bool repair);
+
+/// IoError naming the first output path whose folder does not exist (or is not a folder).
+/// Commands that write several files call it before any work, so that a bad second path
+/// cannot fail the command after the first file was written. Empty paths are skipped.
+Status require_output_folders(const std::vector<std::string>& paths);
 
 /// The `check` report of a mesh as JSON (key names as in shared/meshes/manifest.json).
 Json mesh_check_json(const std::string& file, const MeshCheck& check);

@@ -9,6 +9,7 @@
 #include "cli_common.h"
 #include "commands.h"
 #include "spherekit/check_mesh.h"
+#include "spherekit/formats/feature_io.h"
 #include "spherekit/formats/mesh_io.h"
 
 namespace spherekit::cli {
@@ -19,6 +20,7 @@ struct CheckArgs {
   bool json = false;
   bool repair = false;
   std::string output;
+  std::string landmarks;
 };
 
 void print_human(const std::string& path, const MeshCheck& c, const Status& verdict) {
@@ -40,6 +42,11 @@ void print_human(const std::string& path, const MeshCheck& c, const Status& verd
 int run_check(const CheckArgs& args) {
   if (args.repair && args.meshes.size() != 1)
     return print_error(Status(ErrorCode::InvalidArgument, "--repair takes exactly one MESH"));
+  if (!args.landmarks.empty() && args.meshes.size() != 1)
+    return print_error(Status(ErrorCode::InvalidArgument, "--landmarks takes exactly one MESH"));
+  if (args.repair) {
+    if (Status s = require_output_folders({args.output}); !s.ok()) return print_error(s);
+  }
 
   int worst = 0;
   Json report = Json::array();
@@ -54,6 +61,9 @@ int run_check(const CheckArgs& args) {
       continue;
     }
     LoadedMesh& m = loaded.value();
+    // Landmarks index the vertices of the file as read (before --repair appends any).
+    Result<std::vector<Landmark>> landmarks = std::vector<Landmark>{};
+    if (!args.landmarks.empty()) landmarks = formats::read_landmarks(args.landmarks, m.check.vertices);
 
     int split = 0;
     if (args.repair) {
@@ -65,20 +75,29 @@ int run_check(const CheckArgs& args) {
     }
 
     // Holes are accepted: the stages close them with removable faces.
-    const Status verdict = with_file(require_genus0(m.check, /*allow_boundary=*/true), path);
+    const Status verdict = param_verdict(m, /*allow_boundary=*/true);
 
     if (args.json) {
       Json j = mesh_check_json(path, m.check);
       if (!verdict.ok()) j["error"] = verdict.message();
       if (args.repair) j["repair"] = Json{{"split_vertices", split}, {"output", args.output}};
+      if (!args.landmarks.empty()) {
+        if (landmarks.ok())
+          j["landmarks"] = Json{{"file", args.landmarks}, {"count", landmarks->size()}};
+        else
+          j["landmarks"] = Json{{"file", args.landmarks}, {"error", landmarks.status().message()}};
+      }
       report.push_back(std::move(j));
     } else {
       print_human(path, m.check, verdict);
       if (args.repair)
         std::printf("  repair: split %d pinched vertex fan%s; wrote %s\n", split, split == 1 ? "" : "s",
                     args.output.c_str());
+      if (!args.landmarks.empty() && landmarks.ok())
+        std::printf("  landmarks: %zu in %s, all valid\n", landmarks->size(), args.landmarks.c_str());
     }
     if (!verdict.ok()) worst = worse_exit_code(worst, print_error(verdict));
+    if (!landmarks.ok()) worst = worse_exit_code(worst, print_error(landmarks.status()));
   }
   if (args.json) std::printf("%s\n", report.dump(2).c_str());
   return worst;
@@ -96,16 +115,19 @@ void register_check(CLI::App& app) {
       "(one manifold, oriented, genus-0 component; holes allowed). Exit code: 0 if every mesh is\n"
       "accepted, 3 if a mesh is malformed or not accepted, 4 if a file cannot be read (the worst\n"
       "over all files). --repair splits pinched vertices (one copy per face fan) and writes the\n"
-      "result to -o, whatever the verdict.",
+      "result to -o, whatever the verdict. --landmarks also validates a landmark file against the\n"
+      "mesh (lines 'name vertex_index': indices in range, names and vertices unique).",
       "  spherekit check spot.obj bunny.obj\n"
       "  spherekit check --json meshes/*.obj > checks.json\n"
-      "  spherekit check cow.obj --repair -o cow_fixed.obj");
+      "  spherekit check cow.obj --repair -o cow_fixed.obj\n"
+      "  spherekit check cat.obj --landmarks cat.lm.txt");
   cmd->add_option("MESH", args->meshes, "mesh files (.obj .ply .off .stl .gltf .glb)")->required();
   cmd->add_flag("--json", args->json, "print a JSON array with one object per mesh instead of text");
   CLI::Option* repair = cmd->add_flag("--repair", args->repair, "split non-manifold (pinched) vertices; needs -o");
   CLI::Option* output = cmd->add_option("-o,--output", args->output, "where --repair writes the repaired mesh (.obj/.ply)");
   repair->needs(output);
   output->needs(repair);
+  cmd->add_option("--landmarks", args->landmarks, "also validate this landmark file (name vertex_index) against MESH");
   cmd->callback([args] { set_exit_code(run_check(*args)); });
 }
 

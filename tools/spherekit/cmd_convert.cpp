@@ -1,17 +1,22 @@
 // `spherekit convert`: a mesh and its sphere map -> an octahedral geometry image (float EXR),
-// optionally the remesh it defines (OBJ), with the remesh PSNR against the original.
+// optionally the remesh it defines (OBJ) and Draco glTF levels of detail, with the remesh PSNR
+// against the original.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli_common.h"
 #include "commands.h"
 #include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/convert/gltf_lods.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/geometry_image.h"
+#include "spherekit/metrics.h"
 #include "spherekit/version.h"
 
 namespace spherekit::cli {
@@ -25,8 +30,23 @@ struct ConvertArgs {
   std::string report;
   int size = 257;
   int psnr_samples = RemeshErrorOptions{}.samples;
+  int lods = 0;  // glTF levels of detail (0: none)
+  convert::QuantizationBudget budget;
   bool quiet = false;
 };
+
+// OUT.exr -> OUT (the glTF files are OUT_lod0.glb ... and OUT_lods.glb).
+std::string gltf_prefix(const std::string& output) {
+  const std::size_t slash = output.find_last_of('/'), dot = output.find_last_of('.');
+  if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) return output.substr(0, dot);
+  return output;
+}
+
+std::uintmax_t file_bytes(const std::string& path) {
+  std::error_code ec;
+  const std::uintmax_t n = std::filesystem::file_size(path, ec);
+  return ec ? 0 : n;
+}
 
 Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
@@ -37,14 +57,32 @@ int run_convert(const ConvertArgs& a) {
                               strprintf("--size %d is not 2^k+1 (e.g. 65, 129, 257, 513)", a.size)));
   if (a.psnr_samples < 0)
     return print_error(Status(ErrorCode::InvalidArgument, "--psnr-samples must be >= 0"));
+  if (a.lods < 0 || a.lods > 30 || (a.lods > 0 && ((a.size - 1) >> (a.lods - 1)) < 2))
+    return print_error(Status(ErrorCode::InvalidArgument,
+                              strprintf("--lods %d does not fit --gi %d (the coarsest level needs >= 3 x 3 texels)",
+                                        a.lods, a.size)));
+
+  // Every output folder before any work: a bad --report path must not fail the command
+  // after the image was written.
+  if (Status s = require_output_folders({a.output, a.remesh, a.report}); !s.ok()) return print_error(s);
 
   Stopwatch wall;
   auto loaded = load_mesh(a.mesh);
   if (!loaded.ok()) return print_error(loaded.status());
   const LoadedMesh& m = loaded.value();
+  // Only meshes param accepts have sphere maps; anything else would be resampled into garbage.
+  if (Status s = param_verdict(m, /*allow_boundary=*/true); !s.ok()) return print_error(s);
   Stopwatch read_sphere;
   auto map = formats::read_sphere_map(a.sphere, m.mesh);
   if (!map.ok()) return print_error(with_file(map.status(), a.sphere));
+  // A folded map sends texels to the wrong faces: the image would look valid and be wrong.
+  // The exact predicate decides, as for param's own output.
+  if (const int flipped = count_flipped_faces(m.mesh.F, map->S); flipped != 0)
+    return print_error(Status(ErrorCode::InvalidInput,
+                              strprintf("%s: not a bijective sphere map of %s (%d of %lld faces flipped or "
+                                        "degenerate on the sphere); nothing written",
+                                        a.sphere.c_str(), a.mesh.c_str(), flipped,
+                                        static_cast<long long>(m.mesh.F.rows()))));
   const double read_seconds = m.read_seconds + read_sphere.seconds();
 
   Stopwatch sample_time;
@@ -79,6 +117,43 @@ int run_convert(const ConvertArgs& a) {
     if (has_holes) err_all = remesh_error(m.mesh, remesh, opts);
     psnr_seconds = psnr_time.seconds();
   }
+  // glTF levels of detail: the position bits come from the error budget of the image's own
+  // remesh error (when measured), the PSNR of each level is that of the decoded glTF geometry.
+  convert::GltfLods lods;
+  convert::GltfLodPaths lod_paths;
+  std::vector<RemeshError> lod_errors;
+  double gltf_seconds = 0, gltf_psnr_seconds = 0;
+  if (a.lods > 0) {
+    Stopwatch gltf_time;
+    convert::GltfLodOptions opts;
+    opts.levels = a.lods;
+    opts.budget = a.budget;
+    opts.reference_rms_error = a.psnr_samples > 0 ? err.rms : 0;
+    opts.name = file_stem(a.mesh);
+    opts.provenance = {a.mesh, a.sphere};
+    ProgressRenderer progress(a.quiet, file_stem(a.mesh));
+    auto built = convert::build_gltf_lods(image, opts, progress.callback());
+    progress.finish();
+    if (!built.ok()) return print_error(built.status());
+    lods = std::move(built).value();
+    auto written = convert::write_gltf_lods(gltf_prefix(a.output), lods);
+    if (!written.ok()) return print_error(written.status());
+    lod_paths = std::move(written).value();
+    gltf_seconds = gltf_time.seconds();
+    if (cancel_requested()) return print_error(cancelled_status());
+    if (a.psnr_samples > 0) {
+      Stopwatch t;
+      RemeshErrorOptions opts_err;
+      opts_err.samples = a.psnr_samples;
+      for (const convert::GltfLodLevel& level : lods.levels) {
+        const convert::GltfMesh& d = level.primitive.decoded.mesh;
+        TriMesh decoded{d.V, d.F};
+        lod_errors.push_back(remesh_error(m.mesh, decoded, opts_err, convert::gltf_mesh_hole_faces(d, image)));
+        if (cancel_requested()) return print_error(cancelled_status());
+      }
+      gltf_psnr_seconds = t.seconds();
+    }
+  }
   const double wall_seconds = wall.seconds();
 
   if (!a.report.empty()) {
@@ -105,6 +180,37 @@ int run_convert(const ConvertArgs& a) {
       if (has_holes) j["psnr_db_all_faces"] = number_or_null(err_all.psnr);
       j["psnr_samples"] = a.psnr_samples;
     }
+    if (a.lods > 0) {
+      Json levels = Json::array();
+      for (std::size_t k = 0; k < lods.levels.size(); ++k) {
+        const convert::GltfLodLevel& level = lods.levels[k];
+        Json l;
+        l["file"] = lod_paths.levels[k];
+        l["bytes"] = file_bytes(lod_paths.levels[k]);
+        l["draco_bytes"] = level.primitive.bytes.size();
+        l["size"] = level.image_size;
+        l["V"] = level.primitive.decoded.mesh.V.rows();
+        l["F"] = level.primitive.decoded.mesh.F.rows();
+        l["screen_coverage"] = lods.screen_coverage[k];
+        if (k < lod_errors.size()) {
+          l["psnr_db"] = number_or_null(lod_errors[k].psnr);
+          l["rms"] = lod_errors[k].rms;
+        }
+        levels.push_back(std::move(l));
+      }
+      j["lods"] = std::move(levels);
+      j["lods_file"] = {{"file", lod_paths.combined}, {"bytes", file_bytes(lod_paths.combined)}};
+      const convert::DracoQuantization& q = lods.quantization.quantization;
+      j["quantization"] = {{"position_bits", q.position_bits},
+                           {"normal_bits", q.normal_bits},
+                           {"texcoord_bits", q.texcoord_bits},
+                           {"position_step", q.position_step()},
+                           {"position_max_error", lods.quantization.position_max_error},
+                           {"reference_rms_error", lods.quantization.reference_rms_error},
+                           {"position_error_fraction", lods.quantization.position_error_fraction}};
+      j["times"]["gltf"] = gltf_seconds;
+      j["times"]["gltf_psnr"] = gltf_psnr_seconds;
+    }
     j["times"]["read"] = read_seconds;
     j["times"]["sample"] = sample_seconds;
     j["times"]["remesh"] = remesh_seconds;
@@ -127,8 +233,27 @@ int run_convert(const ConvertArgs& a) {
       if (has_holes)
         std::printf("  (remesh faces spanning the holes left out; with them: PSNR %.2f dB)\n", err_all.psnr);
     }
-    std::printf("  time: read %.2f s, sample %.3f s, remesh %.3f s, write %.2f s, PSNR %.2f s, total %.2f s\n",
-                read_seconds, sample_seconds, remesh_seconds, write_seconds, psnr_seconds, wall_seconds);
+    if (a.lods > 0) {
+      const convert::DracoQuantization& q = lods.quantization.quantization;
+      std::printf("  glTF (Draco, %d/%d/%d bits position/normal/texcoord%s):\n", q.position_bits, q.normal_bits,
+                  q.texcoord_bits, lods.quantization.reference_rms_error > 0 ? ", from the error budget" : "");
+      for (std::size_t k = 0; k < lods.levels.size(); ++k) {
+        const convert::GltfLodLevel& level = lods.levels[k];
+        std::printf("    %s  %3d x %-3d %8lld points %8lld faces %10llu bytes", lod_paths.levels[k].c_str(),
+                    level.image_size, level.image_size,
+                    static_cast<long long>(level.primitive.decoded.mesh.V.rows()),
+                    static_cast<long long>(level.primitive.decoded.mesh.F.rows()),
+                    static_cast<unsigned long long>(file_bytes(lod_paths.levels[k])));
+        if (k < lod_errors.size()) std::printf("  PSNR %.2f dB", lod_errors[k].psnr);
+        std::printf("\n");
+      }
+      std::printf("    %s  all levels (MSFT_lod) %llu bytes\n", lod_paths.combined.c_str(),
+                  static_cast<unsigned long long>(file_bytes(lod_paths.combined)));
+    }
+    std::printf("  time: read %.2f s, sample %.3f s, remesh %.3f s, write %.2f s, PSNR %.2f s, %stotal %.2f s\n",
+                read_seconds, sample_seconds, remesh_seconds, write_seconds, psnr_seconds,
+                a.lods > 0 ? strprintf("glTF %.2f s + PSNR %.2f s, ", gltf_seconds, gltf_psnr_seconds).c_str() : "",
+                wall_seconds);
   }
   return 0;
 }
@@ -138,26 +263,40 @@ int run_convert(const ConvertArgs& a) {
 void register_convert(CLI::App& app) {
   auto args = std::make_shared<ConvertArgs>();
   CLI::App* cmd = add_command(
-      app, "convert", "Resample a mesh through its sphere map into an octahedral geometry image (EXR)",
+      app, "convert", "Resample a mesh through its sphere map into an octahedral geometry image (EXR) and glTF LODs",
       "Resample a mesh through its sphere map (as written by `spherekit param`) into an N x N\n"
       "octahedral geometry image (N = 2^k+1): each texel's sphere point is located in the sphere\n"
       "map and the surface position and normal are interpolated there. Writes a float EXR\n"
       "(R,G,B = position, N.X,N.Y,N.Z = normal, face_id; ZIP; provenance in the header), and\n"
       "with --remesh the triangle mesh the image defines. Prints the remesh PSNR against the\n"
       "original (peak = bounding-box diagonal, symmetric RMS surface distance); --report writes\n"
-      "it with the timings as JSON. Exit codes: 2 bad flags (e.g. --size not 2^k+1), 3 bad\n"
-      "input, 4 I/O error.",
+      "it with the timings as JSON. With --lods L it also writes L levels of detail (image sizes\n"
+      "N, (N-1)/2+1, ...) as Draco-compressed glTF (POSITION, NORMAL, TEXCOORD_0 = texel centres\n"
+      "of the image): OUT_lod0.glb ... one per level, and OUT_lods.glb with all of them (MSFT_lod,\n"
+      "level 0 shown by viewers without it), OUT being -o without its extension. Position bits:\n"
+      "the fewest >= --min-position-bits whose quantization error is at most a tenth of the\n"
+      "measured remesh error (recorded in the glTF extras and the report, with each level's\n"
+      "size and the PSNR of its decoded geometry). The mesh must be one `param` accepts and the\n"
+      "map a bijection (no face flipped by the exact predicate). Exit codes: 2 bad flags (e.g.\n"
+      "--size not 2^k+1), 3 bad input (including a folded map), 4 I/O error.",
       "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr\n"
       "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr --size 129 --remesh bunny.gim.obj\n"
-      "  spherekit convert igea.ply igea.sphere.obj -o igea.exr --report igea.convert.json");
+      "  spherekit convert igea.ply igea.sphere.obj -o igea.exr --report igea.convert.json\n"
+      "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --gi 257 --lods 4");
   cmd->add_option("MESH", args->mesh, "input mesh (.obj .ply .off .stl .gltf .glb)")->required();
   cmd->add_option("SPHERE", args->sphere, "its sphere map (.obj, from `spherekit param`)")->required();
   cmd->add_option("-o,--output", args->output, "geometry image to write (.exr)")->required();
-  cmd->add_option("--size", args->size, "image size N = 2^k+1 (default 257)");
+  cmd->add_option("--size,--gi", args->size, "image size N = 2^k+1 (default 257)");
   cmd->add_option("--remesh", args->remesh, "also write the remesh defined by the image (.obj .ply)");
   cmd->add_option("--report", args->report, "also write a JSON report here");
   cmd->add_option("--psnr-samples", args->psnr_samples,
                   "points sampled per direction for the PSNR (0: skip it; default 400000)");
+  cmd->add_option("--lods", args->lods, "also write this many glTF levels of detail (default 0: none)");
+  cmd->add_option("--min-position-bits", args->budget.min_position_bits,
+                  "glTF: fewest Draco position bits (default 14; more if the error budget needs them)");
+  cmd->add_option("--normal-bits", args->budget.normal_bits, "glTF: Draco normal bits (default 10)");
+  cmd->add_option("--min-texcoord-bits", args->budget.min_texcoord_bits,
+                  "glTF: fewest Draco texture-coordinate bits (default 12)");
   cmd->add_flag("-q,--quiet", args->quiet, "print no summary (errors still)");
   cmd->callback([args] { set_exit_code(run_convert(*args)); });
 }

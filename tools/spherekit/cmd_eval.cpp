@@ -3,14 +3,13 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cli_common.h"
 #include "commands.h"
+#include "spherekit/formats/feature_io.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/metrics.h"
 
@@ -24,34 +23,14 @@ struct EvalArgs {
   bool json = false;
 };
 
-// evalsphere.py's --targets format: `name vertex_index x y z` per line. Parsed here because
-// it exists only for evaluation; `#` comments and blank lines are skipped like the
-// landmark files'.
+// evalsphere.py's --targets format, `name vertex_index x y z` per line, read by
+// formats::read_landmark_targets: indices in range, unit vectors, unique names and vertices.
 Result<std::vector<FeatureTarget>> read_targets(const std::string& path, int num_vertices) {
-  std::ifstream in(path);
-  if (!in) return Status(ErrorCode::IoError, path + ": cannot open targets file");
+  auto read = formats::read_landmark_targets(path, num_vertices);
+  if (!read.ok()) return with_file(read.status(), path);
   std::vector<FeatureTarget> targets;
-  std::string line;
-  for (int line_no = 1; std::getline(in, line); ++line_no) {
-    if (const size_t hash = line.find('#'); hash != std::string::npos) line.erase(hash);
-    std::istringstream fields(line);
-    std::string name;
-    if (!(fields >> name)) continue;
-    long long vertex = 0;
-    double x = 0, y = 0, z = 0;
-    std::string extra;
-    if (!(fields >> vertex >> x >> y >> z) || (fields >> extra))
-      return Status(ErrorCode::ParseError,
-                    strprintf("%s:%d: expected 'name vertex_index x y z'", path.c_str(), line_no));
-    if (vertex < 0 || vertex >= num_vertices)
-      return Status(ErrorCode::InvalidInput, strprintf("%s:%d: vertex index %lld out of range [0, %d)", path.c_str(),
-                                                       line_no, vertex, num_vertices));
-    const Eigen::Vector3d p(x, y, z);
-    if (!p.allFinite() || p.norm() == 0)
-      return Status(ErrorCode::InvalidInput,
-                    strprintf("%s:%d: target point must be finite and non-zero", path.c_str(), line_no));
-    targets.push_back(FeatureTarget{static_cast<int>(vertex), p.normalized()});
-  }
+  targets.reserve(read->size());
+  for (const formats::LandmarkTarget& t : read.value()) targets.push_back(FeatureTarget{t.vertex, t.p});
   return targets;
 }
 
@@ -77,6 +56,8 @@ void print_human(const EvalArgs& a, const SphereMapMetrics& m) {
 int run_eval(const EvalArgs& a) {
   auto mesh = formats::read_mesh(a.mesh);
   if (!mesh.ok()) return print_error(with_file(mesh.status(), a.mesh));
+  // Out-of-range coordinates make every stretch measure NaN or 0: refuse them like param does.
+  if (Status s = require_supported_coordinates(mesh.value(), a.mesh); !s.ok()) return print_error(s);
 
   // The sphere file is read as a plain mesh, not with read_sphere_map, because that
   // normalizes the points and radius_dev must report how far from unit they really are
@@ -92,6 +73,19 @@ int run_eval(const EvalArgs& a) {
                               strprintf("%s: sphere map has %lld vertices, mesh %s has %lld", a.sphere.c_str(),
                                         static_cast<long long>(sphere->V.rows()), a.mesh.c_str(),
                                         static_cast<long long>(nv))));
+
+  // The evaluator normalises the points itself, in plain double arithmetic: beyond these
+  // radii |s|^2 overflows or underflows and every measure becomes NaN or 0 ("zero point").
+  // read_sphere_map (convert) normalises such points exactly; eval must see them as written.
+  for (Eigen::Index i = 0; i < sphere->V.rows(); ++i) {
+    const double radius = sphere->V.row(i).cwiseAbs().maxCoeff();
+    if (radius > kMaxCoordinate || (radius > 0 && radius < kMinExtent))
+      return print_error(Status(ErrorCode::InvalidInput,
+                                strprintf("%s: point %lld is %.3g from the origin, outside the %.0e..%.0e eval "
+                                          "can measure; normalise the points",
+                                          a.sphere.c_str(), static_cast<long long>(i), sphere->V.row(i).stableNorm(),
+                                          kMinExtent, kMaxCoordinate)));
+  }
 
   std::vector<FeatureTarget> targets;
   if (!a.targets.empty()) {
@@ -128,7 +122,8 @@ void register_eval(CLI::App& app) {
       "  spherekit eval cat0.obj cat0.sphere.obj --targets cat0.targets.txt --json");
   cmd->add_option("MESH", args->mesh, "the surface mesh")->required();
   cmd->add_option("SPHERE", args->sphere, "the sphere map (.obj; vertex positions = sphere points)")->required();
-  cmd->add_option("--targets", args->targets, "lines 'name vertex_index x y z': where feature vertices must land");
+  cmd->add_option("--targets", args->targets,
+                  "lines 'name vertex_index x y z' (x y z a unit vector): where feature vertices must land");
   cmd->add_flag("--json", args->json, "print one JSON line instead of text");
   cmd->callback([args] { set_exit_code(run_eval(*args)); });
 }

@@ -1,0 +1,7 @@
+// libFuzzer harness: the Wavefront OBJ reader.
+#include "fuzz_common.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  spherekit::fuzz::fuzz_mesh("fuzz.obj", data, size);
+  return 0;
+}

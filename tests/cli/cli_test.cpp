@@ -347,6 +347,20 @@ TEST_CASE("param writes a bijective unit sphere map and eval agrees", "[cli]") {
   require_one_line_error(mismatch, sphere);
 }
 
+TEST_CASE("param checks every output folder before writing anything", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_param_folders");
+  const std::string out_dir = dir + "/out";
+  fs::create_directories(out_dir);
+  const std::string mesh = write_obj(dir, "blob.obj", spherekit::test::random_blob(1, 3));
+  CliRun p = run_cli("param " + quote(mesh) + " -o " + quote(out_dir + "/blob.sphere.obj") + " --report " +
+                         quote(dir + "/missing/r.json"),
+                     dir);
+  CHECK(p.exit_code == 4);
+  CHECK(p.err.find("missing") != std::string::npos);
+  CHECK(std::count(p.err.begin(), p.err.end(), '\n') == 1);
+  CHECK(files_in(out_dir).empty());
+}
+
 TEST_CASE("param on a mesh with holes maps the original vertices only", "[cli]") {
   const std::string dir = spherekit::test::temp_dir("cli_param_holes");
   const TriMesh holes = spherekit::test::sphere_with_holes(2, 2);

@@ -73,6 +73,13 @@ std::string network_obj(const FeatureNetworkReport& n) {
   return out;
 }
 
+Json provenance_json(const Provenance& p) {
+  return Json{{"library_version", p.library_version},
+              {"method", p.method},
+              {"options_digest", p.options_digest},
+              {"seed", p.seed}};
+}
+
 int run_constrained(const ParamArgs& a, const LoadedMesh& m, const Stopwatch& wall) {
   auto lms = formats::read_landmarks(a.features, m.check.vertices);
   if (!lms.ok()) return print_error(with_file(lms.status(), a.features));
@@ -165,10 +172,7 @@ int run_constrained(const ParamArgs& a, const LoadedMesh& m, const Stopwatch& wa
     j["options"]["edge_flips"] = o.edge_flips;
     j["options"]["sidedness"] = o.sidedness;
     j["version"] = kVersion;
-    j["provenance"] = Json{{"library_version", r.map.provenance.library_version},
-                           {"method", r.map.provenance.method},
-                           {"options_digest", r.map.provenance.options_digest},
-                           {"seed", r.map.provenance.seed}};
+    j["provenance"] = provenance_json(r.map.provenance);
     if (Status s = write_json_atomic(a.report, j); !s.ok()) return print_error(s);
   }
   if (!a.quiet) {
@@ -187,6 +191,8 @@ int run_constrained(const ParamArgs& a, const LoadedMesh& m, const Stopwatch& wa
 
 int run_param(const ParamArgs& a) {
   Stopwatch wall;
+  // Every output folder must exist before any work: no partial set of outputs on failure.
+  if (Status s = require_output_folders({a.output, a.report, a.dump_network}); !s.ok()) return print_error(s);
   auto loaded = load_mesh_checked(a.mesh, /*allow_boundary=*/true, /*repair=*/false);
   if (!loaded.ok()) return print_error(loaded.status());
   const LoadedMesh& m = loaded.value();
@@ -237,10 +243,7 @@ int run_param(const ParamArgs& a) {
     j["peak_rss_mb"] = peak_mb;
     j["options"] = sphere_param_options_json(a.options);
     j["version"] = kVersion;
-    j["provenance"] = Json{{"library_version", r.map.provenance.library_version},
-                           {"method", r.map.provenance.method},
-                           {"options_digest", r.map.provenance.options_digest},
-                           {"seed", r.map.provenance.seed}};
+    j["provenance"] = provenance_json(r.map.provenance);
     if (Status s = write_json_atomic(a.report, j); !s.ok()) return print_error(s);
   }
   if (!a.quiet) print_summary(a, m, r, wall_seconds, cpu, peak_mb);

@@ -16,6 +16,7 @@
 
 #include "detail/path_network.h"
 #include "detail/sphere_embedding.h"
+#include "detail/stage_util.h"
 #include "spherekit/check_mesh.h"
 #include "spherekit/fill_holes.h"
 #include "spherekit/metrics.h"
@@ -26,9 +27,7 @@
 namespace spherekit {
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using detail::seconds_since;
 
 std::string options_digest(const ConstrainedParamOptions& o) {
   char buf[384];
@@ -39,10 +38,7 @@ std::string options_digest(const ConstrainedParamOptions& o) {
                 s.regularizer_weight, s.hole_weight, s.hole_shape_weight, static_cast<unsigned long long>(s.seed),
                 s.effort, o.steiner_penalty, o.min_angle_deg, o.extremity_fraction, o.sidedness ? 1 : 0,
                 o.unswirl ? 1 : 0, o.edge_flips ? 1 : 0);
-  std::uint64_t h = 1469598103934665603ULL;
-  for (const char* p = buf; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  return detail::options_digest_hex(buf);
 }
 
 // Rotation R minimizing sum |R a_i - b_i|^2 (orthogonal Procrustes / Kabsch).
@@ -367,10 +363,10 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   const int k = static_cast<int>(fv.size());
 
   // 3. Normalize (centre, unit bounding-box diagonal) as the unconstrained stage does.
-  Eigen::RowVector3d lo = closed.V.colwise().minCoeff(), hi = closed.V.colwise().maxCoeff();
-  double diag = (hi - lo).norm();
+  const detail::Normalization nz = detail::bounding_box_normalization(closed.V);
+  const double diag = nz.diagonal;
   if (!(diag > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
-  RowMat3d Pn = (closed.V.rowwise() - 0.5 * (lo + hi)) / diag;
+  RowMat3d Pn = (closed.V.rowwise() - nz.centre) / diag;
 
   // 4. Path network.
   auto t0 = std::chrono::steady_clock::now();
@@ -395,7 +391,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   for (const auto& p : net.paths) {
     rep.arcs.push_back({p.a, p.b});
     std::vector<Eigen::Vector3d> line;
-    for (int v : p.verts) line.push_back(net.X[static_cast<size_t>(v)] * diag + (0.5 * (lo + hi)).transpose());
+    for (int v : p.verts) line.push_back(net.X[static_cast<size_t>(v)] * diag + nz.centre.transpose());
     rep.polylines.push_back(std::move(line));
   }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "detail/sphere_embedding.h"
+#include "detail/stage_util.h"
 #include "spherekit/check_mesh.h"
 #include "spherekit/fill_holes.h"
 #include "spherekit/metrics.h"
@@ -17,20 +18,13 @@
 namespace spherekit {
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using detail::seconds_since;
 
-// Digest of the shape-defining options (FNV-1a over their printed values): recorded in
-// provenance so two maps can be compared for "made the same way".
 std::string options_digest(const SphereParamOptions& o) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "reg=%.17g;hole=%.17g;hshape=%.17g;seed=%llu;effort=%d;align=%d", o.regularizer_weight, o.hole_weight, o.hole_shape_weight,
                 static_cast<unsigned long long>(o.seed), o.effort, o.align_rotation ? 1 : 0);
-  std::uint64_t h = 1469598103934665603ULL;
-  for (const char* p = buf; *p; ++p) h = (h ^ static_cast<unsigned char>(*p)) * 1099511628211ULL;
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  return detail::options_digest_hex(buf);
 }
 
 // Rotation that best aligns each face's sphere direction with its surface normal (area
@@ -82,10 +76,9 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
 
   // 3. Normalize: centre and scale to unit bounding-box diagonal so that every tolerance in
   //    the simplifier is relative to the model (stretch efficiency is scale-invariant).
-  Eigen::RowVector3d lo = closed.V.colwise().minCoeff(), hi = closed.V.colwise().maxCoeff();
-  double diag = (hi - lo).norm();
-  if (!(diag > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
-  RowMatXd P = (closed.V.rowwise() - 0.5 * (lo + hi)) / diag;
+  const detail::Normalization nz = detail::bounding_box_normalization(closed.V);
+  if (!(nz.diagonal > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
+  RowMatXd P = (closed.V.rowwise() - nz.centre) / nz.diagonal;
 
   // 4. Progressive mesh down to a tetrahedron.
   auto t0 = std::chrono::steady_clock::now();

@@ -10,20 +10,14 @@
 #include "spherekit/fill_holes.h"
 #include "spherekit/metrics.h"
 #include "spherekit/predicates.h"
+#include "map_checks.h"
 #include "test_meshes.h"
 
 using namespace spherekit;
 
 namespace {
 
-void require_valid_map(const TriMesh& mesh, const RowMat3d& S) {
-  REQUIRE(S.rows() == mesh.V.rows());
-  for (Eigen::Index i = 0; i < S.rows(); ++i) REQUIRE(std::abs(S.row(i).norm() - 1.0) < 1e-12);
-  REQUIRE(count_flipped_faces(mesh.F, S) == 0);
-  auto m = evaluate_sphere_map(mesh, S);
-  REQUIRE(m.ok());
-  if (m->closed) REQUIRE(std::abs(m->winding - 1.0) < 1e-9);
-}
+using test::require_valid_map;
 
 void require_on_targets(const RowMat3d& S, const std::vector<int>& fv, const std::vector<Eigen::Vector3d>& t) {
   for (size_t i = 0; i < fv.size(); ++i) {

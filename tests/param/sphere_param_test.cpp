@@ -6,22 +6,14 @@
 #include "spherekit/metrics.h"
 #include "spherekit/predicates.h"
 #include "spherekit/sphere_param.h"
+#include "map_checks.h"
 #include "test_meshes.h"
 
 using namespace spherekit;
 
 namespace {
 
-// Invariants every sphere map must satisfy: unit vectors, every face positively oriented by
-// the exact predicate, winding number +1.
-void require_valid_map(const TriMesh& mesh, const RowMat3d& S) {
-  REQUIRE(S.rows() == mesh.V.rows());
-  for (Eigen::Index i = 0; i < S.rows(); ++i) REQUIRE(std::abs(S.row(i).norm() - 1.0) < 1e-12);
-  REQUIRE(count_flipped_faces(mesh.F, S) == 0);
-  auto m = evaluate_sphere_map(mesh, S);
-  REQUIRE(m.ok());
-  if (m->closed) REQUIRE(std::abs(m->winding - 1.0) < 1e-9);
-}
+using test::require_valid_map;
 
 RowMat3d radial_projection(const TriMesh& m) {
   Eigen::RowVector3d c = m.V.colwise().mean();

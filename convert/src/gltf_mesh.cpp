@@ -92,17 +92,8 @@ Result<GltfMesh> gltf_mesh_from_geometry_image(const GeometryImage& image, int t
   out.N.resize(static_cast<Eigen::Index>(texels), 3);
   out.UV.resize(static_cast<Eigen::Index>(texels), 2);
   out.position_index.resize(texels);
-  // Welded vertex numbering of geometry_image_mesh: canonical texels numbered in order of first
-  // appearance in row-major order.
-  std::vector<int> vertex_of(texels, -1);
-  int nv = 0;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const Eigen::Vector2i c = canonical_texel(i, j, n);
-      const std::size_t canon = static_cast<std::size_t>(c.x()) * n + c.y();
-      if (vertex_of[canon] < 0) vertex_of[canon] = nv++;
-      vertex_of[static_cast<std::size_t>(i) * n + j] = vertex_of[canon];
-    }
+  // Welded vertex numbering of geometry_image_mesh.
+  const std::vector<int> vertex_of = geometry_image_welded_ids(n, nullptr);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
       const auto p = static_cast<Eigen::Index>(i) * n + j;
@@ -119,23 +110,7 @@ Result<GltfMesh> gltf_mesh_from_geometry_image(const GeometryImage& image, int t
       out.position_index[static_cast<std::size_t>(p)] = vertex_of[static_cast<std::size_t>(p)];
     }
 
-  const int m = n - 1, half = m / 2;
-  out.F.resize(2 * static_cast<Eigen::Index>(m) * m, 3);
-  Eigen::Index f = 0;
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      // Cell corners counter-clockwise in (u, v): A (i,j), B (i,j+1), C (i+1,j+1), D (i+1,j).
-      const int A = i * n + j, B = i * n + j + 1, C = (i + 1) * n + j + 1, D = (i + 1) * n + j;
-      // Quadrants u*v > 0 have their diamond edge along the anti-diagonal B-D, the others along
-      // the main diagonal A-C (geometry_image_mesh).
-      if ((j >= half) == (i >= half)) {
-        out.F.row(f++) << A, B, D;
-        out.F.row(f++) << B, C, D;
-      } else {
-        out.F.row(f++) << A, B, C;
-        out.F.row(f++) << A, C, D;
-      }
-    }
+  out.F = geometry_image_grid_faces(n);
   return out;
 }
 

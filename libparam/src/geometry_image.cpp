@@ -148,19 +148,45 @@ Result<GeometryImage> sample_geometry_image(const TriMesh& mesh, const RowMat3d&
 // ---------------------------------------------------------------------------------------
 // Remesh
 
-TriMesh geometry_image_mesh(const GeometryImage& image) {
-  TriMesh out;
-  const int n = image.size;
-  if (!is_geometry_image_size(n) || image.positions.size() != static_cast<std::size_t>(n) * n * 3) return out;
-  std::vector<int> vertex_of(static_cast<std::size_t>(n) * n, -1);
+std::vector<int> geometry_image_welded_ids(int n, int* count) {
+  std::vector<int> id(static_cast<std::size_t>(n) * n, -1);
   int nv = 0;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
       const Eigen::Vector2i c = canonical_texel(i, j, n);
       const std::size_t canon = static_cast<std::size_t>(c.x()) * n + c.y();
-      if (vertex_of[canon] < 0) vertex_of[canon] = nv++;
-      vertex_of[static_cast<std::size_t>(i) * n + j] = vertex_of[canon];
+      if (id[canon] < 0) id[canon] = nv++;
+      id[static_cast<std::size_t>(i) * n + j] = id[canon];
     }
+  if (count) *count = nv;
+  return id;
+}
+
+RowMat3i geometry_image_grid_faces(int n) {
+  const int m = n - 1, half = m / 2;
+  RowMat3i F(2 * static_cast<Eigen::Index>(m) * m, 3);
+  Eigen::Index f = 0;
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j < m; ++j) {
+      // Cell corners counter-clockwise in (u, v): A (i,j), B (i,j+1), C (i+1,j+1), D (i+1,j).
+      const int A = i * n + j, B = i * n + j + 1, C = (i + 1) * n + j + 1, D = (i + 1) * n + j;
+      if ((j >= half) == (i >= half)) {
+        F.row(f++) << A, B, D;
+        F.row(f++) << B, C, D;
+      } else {
+        F.row(f++) << A, B, C;
+        F.row(f++) << A, C, D;
+      }
+    }
+  return F;
+}
+
+TriMesh geometry_image_mesh(const GeometryImage& image) {
+  TriMesh out;
+  const int n = image.size;
+  if (!is_geometry_image_size(n) || image.positions.size() != static_cast<std::size_t>(n) * n * 3) return out;
+  int nv = 0;
+  const std::vector<int> vertex_of = geometry_image_welded_ids(n, &nv);
   out.V.resize(nv, 3);
   std::vector<bool> written(static_cast<std::size_t>(nv), false);
   for (int i = 0; i < n; ++i)
@@ -170,27 +196,9 @@ TriMesh geometry_image_mesh(const GeometryImage& image) {
       written[static_cast<std::size_t>(v)] = true;
       out.V.row(v) = image.position(i, j).cast<double>().transpose();
     }
-  const int m = n - 1, half = m / 2;
-  out.F.resize(2 * static_cast<Eigen::Index>(m) * m, 3);
-  Eigen::Index f = 0;
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      // Cell corners counter-clockwise in (u, v): A (i,j), B (i,j+1), C (i+1,j+1), D (i+1,j).
-      const int A = vertex_of[static_cast<std::size_t>(i) * n + j];
-      const int B = vertex_of[static_cast<std::size_t>(i) * n + j + 1];
-      const int C = vertex_of[static_cast<std::size_t>(i + 1) * n + j + 1];
-      const int D = vertex_of[static_cast<std::size_t>(i + 1) * n + j];
-      // Quadrants u*v > 0 have diamond edges along the anti-diagonal (B-D), the others along
-      // the main diagonal (A-C).
-      const bool u_pos = j >= half, v_pos = i >= half;
-      if (u_pos == v_pos) {
-        out.F.row(f++) << A, B, D;
-        out.F.row(f++) << B, C, D;
-      } else {
-        out.F.row(f++) << A, B, C;
-        out.F.row(f++) << A, C, D;
-      }
-    }
+  out.F = geometry_image_grid_faces(n);
+  for (Eigen::Index f = 0; f < out.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) out.F(f, c) = vertex_of[static_cast<std::size_t>(out.F(f, c))];
   return out;
 }
 

@@ -145,6 +145,18 @@ struct GeometryImage {
 [[nodiscard]] Result<GeometryImage> sample_geometry_image(const TriMesh& mesh, const RowMat3d& S, int resolution,
                                                           const GeometryImageOptions& options = {});
 
+/// Welded numbering of an n x n octahedral image's texels: the folded border identifies
+/// texels (canonical_texel), and each class gets one id, numbered in order of first
+/// appearance in row-major order. Returns the id of every texel (i * n + j); *count gets the
+/// number of ids. The vertex order of geometry_image_mesh.
+std::vector<int> geometry_image_welded_ids(int n, int* count);
+
+/// The triangles of an n x n octahedral grid on texel indices (i * n + j), two per cell,
+/// counter-clockwise in (u, v), split along the diamond edges of the octahedron (the
+/// anti-diagonal in quadrants u * v > 0, the main diagonal elsewhere). The face order of
+/// geometry_image_mesh.
+RowMat3i geometry_image_grid_faces(int n);
+
 /// The remesh an image defines: one vertex per texel with the folded border duplicates
 /// welded (canonical_texel; (N-2)^2 + 2N - 1 vertices, vertex index = order of first
 /// appearance in row-major texel order), two triangles per cell, each cell split along the

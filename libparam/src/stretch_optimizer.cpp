@@ -125,6 +125,11 @@ bool feasible_interval(const RingScratch& ring, const Eigen::Vector3d& x0, const
   double pad = 0.01 * (h - l);
   *lo = l + pad;
   *hi = h - pad;
+  // A vertex already inside the margin (next to a squeezed face) may still move away from
+  // the constraint it is close to: shrink the margin on that side instead of refusing the
+  // whole direction, or the vertices of a squeezed face could never move again.
+  if (!(*lo < 0)) *lo = 0.5 * l;
+  if (!(*hi > 0)) *hi = 0.5 * h;
   return *lo < 0 && *hi > 0;
 }
 

@@ -2,6 +2,7 @@
 // their targets, bijective maps, a path network isomorphic to the arc network, errors.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -260,4 +261,115 @@ TEST_CASE("constrained map is deterministic", "[param][constrained]") {
   REQUIRE(a.ok());
   REQUIRE(b.ok());
   REQUIRE(a->map.S == b->map.S);
+}
+
+namespace {
+
+// A unit sphere with a long thin finger along +z: the cap of polar angle < theta0 becomes a
+// tube of radius sin(theta0) and length `length` closed by a hemispherical tip.
+TriMesh sphere_with_finger(int level, double theta0, double length) {
+  TriMesh m = test::icosphere(level);
+  const double rho = std::sin(theta0), z0 = std::cos(theta0);
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+    Eigen::Vector3d p = m.V.row(v).transpose().normalized();
+    double theta = std::acos(std::clamp(p.z(), -1.0, 1.0));
+    if (theta >= theta0) continue;
+    double az = std::atan2(p.y(), p.x());
+    double u = 1 - theta / theta0;  // 0 at the base, 1 at the tip
+    double r, z;
+    if (u < 0.8) {
+      r = rho;
+      z = z0 + length * u / 0.8;
+    } else {
+      double a = (u - 0.8) / 0.2 * M_PI / 2;
+      r = rho * std::cos(a);
+      z = z0 + length + rho * std::sin(a);
+    }
+    m.V.row(v) = Eigen::RowVector3d(r * std::cos(az), r * std::sin(az), z);
+  }
+  return m;
+}
+
+int nearest_vertex(const TriMesh& m, const Eigen::Vector3d& p) {
+  int best = 0;
+  for (Eigen::Index v = 1; v < m.V.rows(); ++v)
+    if ((m.V.row(v).transpose() - p).squaredNorm() < (m.V.row(best).transpose() - p).squaredNorm())
+      best = static_cast<int>(v);
+  return best;
+}
+
+// Total signed change of the azimuth around the z axis along a polyline (radians).
+double winding_about_z(const std::vector<Eigen::Vector3d>& line) {
+  double total = 0;
+  for (size_t i = 1; i < line.size(); ++i) {
+    double a0 = std::atan2(line[i - 1].y(), line[i - 1].x()), a1 = std::atan2(line[i].y(), line[i].x());
+    double d = a1 - a0;
+    while (d > M_PI) d -= 2 * M_PI;
+    while (d < -M_PI) d += 2 * M_PI;
+    total += d;
+  }
+  return total;
+}
+
+}  // namespace
+
+TEST_CASE("a twisted thin finger gets a bijective map without swirling paths", "[param][constrained][swirl]") {
+  const double theta0 = 0.4, length = 1.5;
+  TriMesh m = sphere_with_finger(4, theta0, length);
+  const double rho = std::sin(theta0), z0 = std::cos(theta0);
+  // Features: the tip, a ring of three around the finger near the tip, a ring of four
+  // around its base on the body, and five on the body (so the targets surround the origin).
+  std::vector<int> fv;
+  std::vector<int> tip_ring;
+  fv.push_back(nearest_vertex(m, {0, 0, z0 + length + rho}));
+  for (int i = 0; i < 3; ++i) {
+    double az = 2 * M_PI * i / 3;
+    tip_ring.push_back(static_cast<int>(fv.size()));
+    fv.push_back(nearest_vertex(m, {rho * std::cos(az), rho * std::sin(az), z0 + 0.85 * length}));
+  }
+  const double tb = theta0 + 0.25;
+  for (int i = 0; i < 4; ++i) {
+    double az = M_PI / 4 + M_PI / 2 * i;
+    fv.push_back(nearest_vertex(m, {std::sin(tb) * std::cos(az), std::sin(tb) * std::sin(az), std::cos(tb)}));
+  }
+  for (const Eigen::Vector3d& d : std::vector<Eigen::Vector3d>{{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, -1}})
+    fv.push_back(nearest_vertex(m, d));
+  // Targets: the unconstrained map's feature images, with the tip ring turned by 150
+  // degrees about the tip's image: the map must twist the finger by that much.
+  SphereParamOptions uo;
+  uo.threads = 1;
+  auto u = parameterize_sphere(m, uo);
+  REQUIRE(u.ok());
+  std::vector<Eigen::Vector3d> t;
+  for (int v : fv) t.push_back(u->map.S.row(v).transpose().normalized());
+  const double twist = 150.0 * M_PI / 180.0;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(twist, t[0]).toRotationMatrix();
+  for (int i : tip_ring) t[static_cast<size_t>(i)] = (R * t[static_cast<size_t>(i)]).normalized();
+
+  ConstrainedParamOptions o;
+  o.sphere.threads = 1;
+  auto r = parameterize_sphere_constrained(m, fv, t, o);
+  REQUIRE(r.ok());
+  require_valid_map(m, r->map.S);
+  require_on_targets(r->map.S, fv, t);
+  const auto& net = r->network;
+  REQUIRE(net.paths == 3 * static_cast<int>(fv.size()) - 6);
+  // No swirl. A path from the tip ring down the finger has to turn about the finger's axis
+  // by the twist (150 degrees) give or take the angular spacing of the rings it joins
+  // (120 degrees on the finger, 90 at the base), i.e. by at most 150 + 60 + 45 = 255
+  // degrees; a swirl wraps it around the finger once more (a full turn, 360 degrees).
+  double max_turn = 0;
+  int finger_paths = 0;
+  for (size_t p = 0; p < net.arcs.size(); ++p) {
+    const int a = std::min(net.arcs[p][0], net.arcs[p][1]), b = std::max(net.arcs[p][0], net.arcs[p][1]);
+    if (!(a >= 1 && a <= 3 && b >= 4 && b <= 7)) continue;  // only paths along the finger
+    ++finger_paths;
+    max_turn = std::max(max_turn, std::abs(winding_about_z(net.polylines[p])));
+  }
+  INFO("max turn about the finger " << max_turn * 180 / M_PI << " deg, max length ratio " << net.max_ratio
+                                    << ", swirls fixed " << net.swirls_fixed);
+  REQUIRE(finger_paths >= 3);  // the rings are joined along the finger, not via the body
+  CHECK(max_turn < 255.0 * M_PI / 180.0);
+  // The twist costs some stretch on the finger, not the map's quality.
+  CHECK(r->efficiency > 0.5 * u->efficiency);
 }

@@ -16,5 +16,7 @@ void register_samples(CLI::App& app);  // cmd_samples.cpp: writes the built-in s
 void register_bench(CLI::App& app);    // cmd_bench.cpp:   per-mesh time/memory/efficiency vs. the reference
 void register_run(CLI::App& app);      // cmd_run.cpp:     the main job: check + param + eval + report
 void register_convert(CLI::App& app);  // cmd_convert.cpp: sphere map -> octahedral geometry image (EXR)
+void register_consistent(CLI::App& app);  // cmd_consistent.cpp: consistent collection + add
+void register_correspond(CLI::App& app);  // cmd_correspond.cpp: point transfer and its error
 
 }  // namespace spherekit::cli

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
       "  spherekit check bunny.obj --json      # structural report\n"
       "  spherekit param bunny.obj -o bunny.sphere.obj --report bunny.json\n"
       "  spherekit eval bunny.obj bunny.sphere.obj --json\n"
+      "  spherekit consistent -o cats cat0.obj cat2.obj cat5.obj   # features coincide on the sphere\n"
       "\n"
       "Exit codes: 0 ok, 2 usage error, 3 invalid/malformed/unsupported input, 4 I/O error,\n"
       "5 solver failed (including a non-bijective result), 6 internal error, 130 cancelled.");
@@ -38,6 +39,8 @@ int main(int argc, char** argv) {
   cli::register_bench(app);
   cli::register_run(app);
   cli::register_convert(app);
+  cli::register_consistent(app);
+  cli::register_correspond(app);
 
   try {
     // The chosen subcommand's callback runs inside parse() and records its exit code.

@@ -1,0 +1,80 @@
+// Consistent spherical parameterization of a collection (Asirvatham, Praun, Hoppe 2005 §3):
+// n genus-0 meshes with corresponding feature vertices are mapped onto one sphere so that
+// corresponding features land on the same sphere points. Two surface points of different
+// meshes then correspond when their sphere points are equal (correspondence.h).
+//
+// The six steps of the paper:
+//   1. unconstrained map of the reference mesh; its feature images are F';
+//   2. constrained maps of the other meshes to F';
+//   3. every mesh remeshed as an octahedral geometry image (identical connectivity), the grid
+//      samples nearest to F' snapped onto the features;
+//   4. the remeshes concatenated into one mesh with vertices in R^{3n};
+//   5. unconstrained map of that mesh (n-D quadric simplification, stretch summed over the
+//      n geometries); the images of the snapped samples are the final locations F;
+//   6. constrained maps of every mesh to F.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "spherekit/constrained_param.h"
+#include "spherekit/mesh.h"
+#include "spherekit/progress.h"
+#include "spherekit/status.h"
+
+namespace spherekit {
+
+struct ConsistentParamOptions {
+  /// Settings of every constrained map (steps 2 and 6); its `sphere` member also drives the
+  /// unconstrained maps of steps 1 and 5. Shape-defining.
+  ConstrainedParamOptions constrained;
+  int reference = 0;          ///< mesh whose unconstrained map gives F' (step 1). Shape-defining.
+  /// Side N (2^k+1) of the step-3 remesh grid; the joint mesh of step 5 has about N^2
+  /// vertices. Shape-defining.
+  int remesh_size = 129;
+  /// false: stop after step 2 (every mesh constrained to the reference's feature images; the
+  /// reference keeps its unconstrained map). For comparisons and quick previews.
+  bool refine_locations = true;
+  /// Worker threads in total (0 = hardware). Steps 2 and 6 map several meshes at once.
+  /// Effort only: the result is the same for any value.
+  int threads = 0;
+};
+
+/// Wall-clock seconds per step (the paper's Table 1 columns).
+struct ConsistentParamTimes {
+  double reference = 0;      ///< step 1
+  double initial = 0;        ///< step 2
+  double remesh = 0;         ///< step 3
+  double concatenate = 0;    ///< step 4
+  double joint = 0;          ///< step 5
+  double final_maps = 0;     ///< step 6
+  double total = 0;
+};
+
+struct ConsistentParamResult {
+  /// One map per mesh (step 6; after step 2 when refine_locations is false, where the
+  /// reference's entry is its unconstrained map with network.paths == 0).
+  std::vector<ConstrainedParamResult> maps;
+  std::vector<Eigen::Vector3d> initial_locations;  ///< F' (step 1), one per feature
+  std::vector<Eigen::Vector3d> final_locations;    ///< F (step 5); equal to F' without refinement
+  double reference_efficiency = 0;  ///< step 1 map's stretch efficiency
+  double joint_efficiency = 0;      ///< step 5: efficiency of the summed stretch (0 if not run)
+  int joint_flips = 0;              ///< step 5 map's flipped faces (exact predicate; 0)
+  int remesh_vertices = 0;          ///< vertices of the joint mesh (0 if not run)
+  ConsistentParamTimes times;
+};
+
+/// Maps n >= 1 meshes consistently. `features[i][k]` is the vertex of mesh i that is
+/// feature k; every mesh has the same number of features (at least 1; 4 or more for
+/// a path network without auxiliary features, see parameterize_sphere_constrained).
+/// Errors name the mesh ("mesh 2: ..."): InvalidArgument (sizes, options), InvalidInput (a
+/// mesh not genus 0, two features on one vertex, ...), SolverFailed (a path network could
+/// not be completed), Cancelled.
+/// Deterministic: same input and options give the same bits, for any thread count.
+Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>& meshes,
+                                                      const std::vector<std::vector<int>>& features,
+                                                      const ConsistentParamOptions& options = {},
+                                                      const ProgressFn& progress = {});
+
+}  // namespace spherekit

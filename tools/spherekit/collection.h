@@ -1,0 +1,52 @@
+// The collection folder `spherekit consistent` writes and `add` / `correspond` read:
+//   DIR/collection.json         manifest: meshes, feature names, F, F', options, versions, times
+//   DIR/features.txt            `name x y z`: the final feature locations F
+//   DIR/<stem>.sphere.obj       one sphere map per mesh (vertex order of the mesh file)
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cli_common.h"
+
+namespace spherekit::cli {
+
+inline constexpr const char* kCollectionManifest = "collection.json";
+inline constexpr const char* kCollectionFormat = "spherekit-collection";
+inline constexpr int kCollectionFormatVersion = 1;
+
+/// What the commands need from a collection folder (the manifest itself is kept too, to be
+/// extended by `add`).
+struct CollectionInfo {
+  std::string dir;
+  Json manifest;
+  std::vector<std::string> feature_names;
+  std::vector<Eigen::Vector3d> locations;  ///< F, one per feature name
+};
+
+/// Reads and validates DIR/collection.json. Errors (naming the file): IoError, ParseError,
+/// InvalidInput (wrong format, missing or inconsistent fields, non-unit locations).
+Result<CollectionInfo> read_collection(const std::string& dir);
+
+/// Index of the member whose map stem or source file matches `mesh_path` (its stem, or the
+/// same absolute path), or -1.
+int find_member(const CollectionInfo& c, const std::string& mesh_path);
+
+/// Creates the folder `dir` with the files `write_into(staging)` writes into an empty
+/// staging folder beside it; the staging folder is renamed into place only once every file
+/// is written, replacing an existing collection folder (or an empty folder). On failure the
+/// staging folder is removed and `dir` is untouched. A non-empty folder that is not a
+/// collection is never replaced. Errors: IoError, or write_into's.
+Status write_collection_folder(const std::string& dir, const std::function<Status(const std::string&)>& write_into);
+
+/// IoError unless `dir` can become a collection folder (absent, empty, or a collection), and
+/// its parent exists. Checked before any work.
+Status require_collection_target(const std::string& dir);
+
+/// `name x y z` lines with 17 significant digits.
+std::string sphere_points_text(const std::vector<std::string>& names, const std::vector<Eigen::Vector3d>& points);
+
+}  // namespace spherekit::cli

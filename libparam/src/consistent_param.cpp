@@ -330,8 +330,20 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   t0 = std::chrono::steady_clock::now();
   std::vector<int> all;
   for (int i = 0; i < n; ++i) all.push_back(i);
-  SPHEREKIT_RETURN_IF_ERROR(
-      constrained_maps(meshes, features, all, result.final_locations, options, "step 6", progress, &result.maps));
+  std::vector<ConstrainedParamResult> final_maps(static_cast<size_t>(n));
+  const Status s6 =
+      constrained_maps(meshes, features, all, result.final_locations, options, "step 6", progress, &final_maps);
+  if (s6.ok()) {
+    result.maps = std::move(final_maps);
+  } else if (s6.code() == ErrorCode::SolverFailed) {
+    // One mesh cannot be mapped to F: the step-2 maps are a complete, consistent answer (all
+    // features on F'), so keep them rather than fail the collection, and say so.
+    result.refinement_failure = s6.message();
+    result.rejected_locations = result.final_locations;
+    result.final_locations = result.initial_locations;
+  } else {
+    return s6;
+  }
   result.times.final_maps = seconds_since(t0);
   result.times.total = seconds_since(t_start);
   return result;

@@ -288,6 +288,21 @@ int run_consistent(const ConsistentArgs& a) {
   man["options"] = constrained_options_json(o.constrained);
   man["options"]["remesh_size"] = o.remesh_size;
   man["options"]["refine_locations"] = o.refine_locations;
+  if (!r.refinement_failure.empty()) {
+    // Which mesh: "mesh 2: ..." -> its name.
+    std::string why = r.refinement_failure;
+    for (size_t i = 0; i < members.size(); ++i) {
+      const std::string tag = "mesh " + std::to_string(i) + ": ";
+      if (why.rfind(tag, 0) == 0) why = members[i].name + ": " + why.substr(tag.size());
+    }
+    man["method"] = "consistent (steps 1-2: reference locations; step 6 failed)";
+    man["refinement_failure"] = why;
+    Json rejected = Json::array();
+    for (const auto& p : r.rejected_locations) rejected.push_back(Json::array({p.x(), p.y(), p.z()}));
+    man["rejected_locations"] = rejected;
+    std::fprintf(stderr, "spherekit: warning: step 6 failed (%s); the collection keeps the step-2 maps (locations from the reference)\n",
+                 why.c_str());
+  }
   man["steps"] = Json{{"reference_efficiency", r.reference_efficiency},
                       {"joint_efficiency", r.joint_efficiency},
                       {"joint_flipped_faces", r.joint_flips},
@@ -318,7 +333,8 @@ int run_consistent(const ConsistentArgs& a) {
   }
   if (!a.quiet) {
     std::printf("collection %s: %zu meshes, %zu features (%s)\n", a.output.c_str(), members.size(), names.size(),
-                o.refine_locations ? "locations from all meshes" : "locations from the reference only");
+                o.refine_locations && r.refinement_failure.empty() ? "locations from all meshes"
+                                                                   : "locations from the reference only");
     Table steps({"step", "work", "time (s)"});
     steps.add_row({"1", "unconstrained map of " + members[static_cast<size_t>(reference)].name,
                    strprintf("%.2f", r.times.reference)});

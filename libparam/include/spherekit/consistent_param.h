@@ -14,6 +14,7 @@
 //   6. constrained maps of every mesh to F.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -62,6 +63,12 @@ struct ConsistentParamResult {
   double joint_efficiency = 0;      ///< step 5: efficiency of the summed stretch (0 if not run)
   int joint_flips = 0;              ///< step 5 map's flipped faces (exact predicate; 0)
   int remesh_vertices = 0;          ///< vertices of the joint mesh (0 if not run)
+  /// Non-empty when step 6 failed for some mesh (a constrained map to F could not be
+  /// completed, e.g. its path network's Steiner vertices could not be removed): the result
+  /// then falls back to the step-2 maps (every feature on F', still consistent) and this
+  /// holds the reason; `rejected_locations` holds the F that was tried.
+  std::string refinement_failure;
+  std::vector<Eigen::Vector3d> rejected_locations;
   ConsistentParamTimes times;
 };
 

@@ -455,4 +455,12 @@ TEST_CASE("run without meshes maps the built-in samples (the README's main job)"
   }
   CHECK(fs::is_directory(out + "/input"));
   CHECK(r.out.find("PSNR129") != std::string::npos);
+  // ... and the consistent collection of the samples, measured against their ground truth.
+  CHECK(fs::exists(out + "/collection/collection.json"));
+  REQUIRE(report.contains("collection"));
+  const json& col = report["collection"];
+  INFO(col.dump());
+  CHECK(col["pairs"] == 12);
+  CHECK(col["mean_error"].get<double>() < 0.05);
+  CHECK(col["under_0.1"].get<double>() > 0.9);
 }

@@ -14,6 +14,7 @@
 #include "cli_common.h"
 #include "collection.h"
 #include "commands.h"
+#include "spherekit/sphere_param.h"
 #include "sample_collection.h"
 #include "spherekit/consistent_param.h"
 #include "spherekit/formats/atomic_file.h"
@@ -132,7 +133,7 @@ struct ConsistentArgs {
   std::string output;
   std::string reference;
   std::string report;
-  int remesh_size = 129;
+  int remesh_size = 65;
   bool no_refine = false;
   bool quiet = false;
   SphereParamOptions sphere;
@@ -457,6 +458,17 @@ int run_add(const AddArgs& a) {
 }
 
 }  // namespace
+
+int run_consistent_job(const std::vector<std::string>& meshes, const std::string& output, const std::string& report,
+                       bool quiet, const SphereParamOptions& sphere) {
+  ConsistentArgs a;
+  a.meshes = meshes;
+  a.output = output;
+  a.report = report;
+  a.quiet = quiet;
+  a.sphere = sphere;
+  return run_consistent(a);
+}
 
 void register_consistent(CLI::App& app) {
   auto args = std::make_shared<ConsistentArgs>();

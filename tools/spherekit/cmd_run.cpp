@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,8 @@
 #include "commands.h"
 #include "sample_collection.h"
 #include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/correspondence.h"
+#include "spherekit/formats/atomic_file.h"
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/metrics.h"
@@ -149,6 +152,53 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
   return out;
 }
 
+// Mean correspondence error of a collection of samples over all ordered pairs, from their
+// .corr.txt ground truth (vertex lists, line k of every file the same point).
+Json collection_correspondence_json(const std::vector<std::string>& meshes, const std::string& col_dir) {
+  struct Member {
+    TriMesh mesh;
+    RowMat3d S;
+    std::vector<int> corr;
+  };
+  std::vector<Member> m;
+  for (const std::string& path : meshes) {
+    auto loaded = load_mesh(path);
+    if (!loaded.ok()) return Json{{"error", loaded.status().message()}};
+    auto map = formats::read_sphere_map((fs::path(col_dir) / (file_stem(path) + ".sphere.obj")).string(), loaded->mesh);
+    if (!map.ok()) return Json{{"error", map.status().message()}};
+    auto text = formats::read_file((fs::path(path).parent_path() / (file_stem(path) + ".corr.txt")).string());
+    if (!text.ok()) return Json{{"error", text.status().message()}};
+    Member x{loaded->mesh, map->S, {}};
+    std::istringstream in(text.value());
+    for (int v; in >> v;) x.corr.push_back(v);
+    m.push_back(std::move(x));
+  }
+  double mean = 0, u5 = 0, u10 = 0;
+  int pairs = 0;
+  Json rows = Json::array();
+  for (size_t i = 0; i < m.size(); ++i)
+    for (size_t j = 0; j < m.size(); ++j) {
+      if (i == j || m[i].corr.size() != m[j].corr.size()) continue;
+      std::vector<SurfacePoint> from;
+      for (int v : m[i].corr) from.push_back(vertex_surface_point(m[i].mesh, v));
+      auto moved = transfer_points(m[i].mesh, m[i].S, from, m[j].mesh, m[j].S);
+      if (!moved.ok()) continue;
+      std::vector<SurfacePoint> predicted;
+      for (const auto& t : moved.value()) predicted.push_back(t.point);
+      auto e = correspondence_error(m[j].mesh, predicted, m[j].corr);
+      if (!e.ok()) continue;
+      rows.push_back(Json{{"from", file_stem(meshes[i])}, {"to", file_stem(meshes[j])}, {"mean", e->mean},
+                          {"under_0.05", e->under_005}, {"under_0.1", e->under_01}});
+      mean += e->mean;
+      u5 += e->under_005;
+      u10 += e->under_01;
+      ++pairs;
+    }
+  if (pairs == 0) return Json{{"error", "no ground truth pairs"}};
+  return Json{{"folder", col_dir},      {"pairs", pairs},          {"mean_error", mean / pairs},
+              {"under_0.05", u5 / pairs}, {"under_0.1", u10 / pairs}, {"per_pair", rows}};
+}
+
 int run_main_job(const RunArgs& a) {
   Stopwatch wall;
   const fs::path out_dir = fs::absolute(a.output).lexically_normal();
@@ -190,6 +240,23 @@ int run_main_job(const RunArgs& a) {
     report["meshes"].push_back(std::move(one.json));
     table.add_row(std::move(one.row));
   }
+  if (use_samples && failed == 0) {
+    // The samples share landmarks: map them consistently too (as `consistent`), and measure
+    // the correspondence the collection induces against their exact ground truth.
+    std::printf("\nConsistent collection of the samples (as 'spherekit consistent'):\n");
+    const std::string col_dir = (out_dir / "collection").string();
+    const int code = run_consistent_job(inputs, col_dir, (out_dir / "collection_report.json").string(), a.quiet,
+                                        a.options);
+    worst = worse_exit_code(worst, code);
+    if (code == 0) {
+      Json col = collection_correspondence_json(inputs, col_dir);
+      report["collection"] = col;
+      std::printf("correspondence vs. ground truth over %d ordered pairs: mean error %.4f, %.1f%% under 0.05, %.1f%% "
+                  "under 0.1 (geodesic / sqrt(area))\n",
+                  col["pairs"].get<int>(), col["mean_error"].get<double>(), 100 * col["under_0.05"].get<double>(),
+                  100 * col["under_0.1"].get<double>());
+    }
+  }
   report["summary"] = Json{{"meshes", inputs.size()},
                            {"ok", static_cast<int>(inputs.size()) - failed},
                            {"failed", failed},
@@ -219,7 +286,10 @@ void register_run(CLI::App& app) {
       "geometry image OUT/<name>.gim129.exr with the remesh PSNR (as `convert --size 129`,\n"
       "100000 PSNR samples per direction), and finally write OUT/report.json (per-mesh check,\n"
       "measures, geometry image and times) and print a summary table and the folder. A mesh that\n"
-      "fails is reported and skipped; the exit code is then that of the worst failure.",
+      "fails is reported and skipped; the exit code is then that of the worst failure.\n"
+      "On the built-in samples it also maps them consistently (as `consistent`) into\n"
+      "OUT/collection and measures that correspondence against the samples' ground truth\n"
+      "(report.json `collection`: mean geodesic error / sqrt(area), fractions under 0.05, 0.1).",
       "  spherekit run                              # built-in samples -> ./spherekit-out\n"
       "  spherekit run spot.obj bunny.obj -o maps   # your meshes -> ./maps\n"
       "  spherekit run ../shared/meshes/*.obj --effort 3");

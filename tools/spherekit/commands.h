@@ -3,8 +3,15 @@
 // cli::set_exit_code() (see cli_common.h). main.cpp only wires them together.
 #pragma once
 
+#include <string>
+#include <vector>
+
 namespace CLI {
 class App;
+}
+
+namespace spherekit {
+struct SphereParamOptions;
 }
 
 namespace spherekit::cli {
@@ -18,5 +25,11 @@ void register_run(CLI::App& app);      // cmd_run.cpp:     the main job: check +
 void register_convert(CLI::App& app);  // cmd_convert.cpp: sphere map -> octahedral geometry image (EXR)
 void register_consistent(CLI::App& app);  // cmd_consistent.cpp: consistent collection + add
 void register_correspond(CLI::App& app);  // cmd_correspond.cpp: point transfer and its error
+
+/// `spherekit consistent -o OUTPUT MESH... [--report REPORT]` with default collection
+/// options (feature files beside the meshes); `run` uses it for the samples. Returns the
+/// exit code.
+int run_consistent_job(const std::vector<std::string>& meshes, const std::string& output, const std::string& report,
+                       bool quiet, const SphereParamOptions& sphere);
 
 }  // namespace spherekit::cli

@@ -32,8 +32,10 @@ struct ConsistentParamOptions {
   ConstrainedParamOptions constrained;
   int reference = 0;          ///< mesh whose unconstrained map gives F' (step 1). Shape-defining.
   /// Side N (2^k+1) of the step-3 remesh grid; the joint mesh of step 5 has about N^2
-  /// vertices. Shape-defining.
-  int remesh_size = 129;
+  /// vertices. Step 5 only decides where the k features go, a low-frequency layout: 65^2
+  /// (4098 vertices, over 100 per feature for k up to 40) resolves it, and the time of
+  /// step 5 grows with N^2 * n. Shape-defining.
+  int remesh_size = 65;
   /// false: stop after step 2 (every mesh constrained to the reference's feature images; the
   /// reference keeps its unconstrained map). For comparisons and quick previews.
   bool refine_locations = true;

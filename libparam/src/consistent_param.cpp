@@ -8,11 +8,11 @@
 #include <limits>
 #include <string>
 
-#include <Eigen/SVD>
 #include <Eigen/SparseCholesky>
 #include <set>
 
 #include "detail/parallel_jobs.h"
+#include "detail/rotation.h"
 #include "detail/sphere_embedding.h"
 #include "detail/stage_util.h"
 #include "spherekit/geometry_image.h"
@@ -52,18 +52,6 @@ ConstrainedParamResult as_constrained(const SphereParamResult& r) {
   c.times.refine = r.times.refine;
   c.times.total = r.times.total;
   return c;
-}
-
-// Rotation R minimizing sum |R a_i - b_i|^2 over proper rotations (Kabsch); identity for
-// fewer than 2 points (the orientation is then free anyway).
-Eigen::Matrix3d kabsch(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  if (a.size() < 2) return Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) M += b[i] * a[i].transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
-  return svd.matrixU() * D * svd.matrixV().transpose();
 }
 
 // Constrained maps of the meshes `which` to `targets`, several at once (steps 2 and 6).
@@ -294,10 +282,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
     const ProgressFn p5 = prefixed(progress, "step 5");
     ProgressiveMeshOptions pmo;
     SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, grid_faces, pmo, p5));
-    detail::OptimizerSettings settings = detail::settings_for_effort(sphere.effort);
-    settings.regularizer_weight = sphere.regularizer_weight;
-    settings.seed = sphere.seed;
-    settings.threads = sphere.threads;
+    const detail::OptimizerSettings settings = detail::optimizer_settings(sphere);
     detail::EmbedInput in;
     in.P = &P;
     in.pm = &pm;
@@ -322,7 +307,9 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   // results comparable between runs with and without refinement).
   std::vector<Eigen::Vector3d> located;
   for (int t : texels) located.push_back(Sj.row(t).transpose());
-  const Eigen::Matrix3d R = kabsch(located, result.initial_locations);
+  // (One feature leaves the orientation free: no rotation.)
+  const Eigen::Matrix3d R =
+      k >= 2 ? detail::best_rotation(located, result.initial_locations) : Eigen::Matrix3d::Identity();
   for (size_t f = 0; f < k; ++f) result.final_locations[f] = (R * located[f]).normalized();
   result.times.joint = seconds_since(t0);
 

@@ -15,6 +15,7 @@
 #include <Eigen/SVD>
 
 #include "detail/path_network.h"
+#include "detail/rotation.h"
 #include "detail/sphere_embedding.h"
 #include "detail/stage_util.h"
 #include "spherekit/check_mesh.h"
@@ -39,28 +40,6 @@ std::string options_digest(const ConstrainedParamOptions& o) {
                 s.effort, o.steiner_penalty, o.min_angle_deg, o.extremity_fraction, o.sidedness ? 1 : 0,
                 o.unswirl ? 1 : 0, o.edge_flips ? 1 : 0);
   return detail::options_digest_hex(buf);
-}
-
-// Rotation R minimizing sum |R a_i - b_i|^2 (orthogonal Procrustes / Kabsch).
-Eigen::Matrix3d best_rotation(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b) {
-  if (a.size() == 1) {
-    // The smallest rotation taking a to b.
-    Eigen::Vector3d axis = a[0].cross(b[0]);
-    double s = axis.norm(), c = a[0].dot(b[0]);
-    if (!(s > 1e-15)) {
-      if (c > 0) return Eigen::Matrix3d::Identity();
-      Eigen::Vector3d o = std::abs(a[0].x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-      axis = (o - o.dot(a[0]) * a[0]).normalized();
-      return Eigen::AngleAxisd(M_PI, axis).toRotationMatrix();
-    }
-    return Eigen::AngleAxisd(std::atan2(s, c), axis / s).toRotationMatrix();
-  }
-  Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-  for (size_t i = 0; i < a.size(); ++i) M += b[i] * a[i].transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) D(2, 2) = -1;
-  return svd.matrixU() * D * svd.matrixV().transpose();
 }
 
 double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -308,7 +287,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     // Rotate the map so the features come closest to their targets.
     std::vector<Eigen::Vector3d> from;
     for (int v : fv) from.push_back(u.map.S.row(v).transpose());
-    Eigen::Matrix3d R = k_given > 0 ? best_rotation(from, targets) : Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d R = k_given > 0 ? detail::best_rotation(from, targets) : Eigen::Matrix3d::Identity();
     RowMat3d S0 = u.map.S * R.transpose();
     S0.rowwise().normalize();
     if (k_given <= 1) {
@@ -417,10 +396,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
 
   // 6. Coarse-to-fine refinement with the features fixed on their targets.
   t0 = std::chrono::steady_clock::now();
-  detail::OptimizerSettings settings = detail::settings_for_effort(so.effort);
-  settings.regularizer_weight = so.regularizer_weight;
-  settings.seed = so.seed;
-  settings.threads = so.threads;
+  const detail::OptimizerSettings settings = detail::optimizer_settings(so);
   std::vector<double> wnet(static_cast<size_t>(nnf), 1.0), snet(static_cast<size_t>(nnf), 0.0);
   for (int f = 0; f < nnf; ++f)
     if (net.face_origin[static_cast<size_t>(f)] >= filled.original_faces) {

@@ -91,10 +91,7 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
 
   // 5. Coarse-to-fine embedding with stretch optimization.
   t0 = std::chrono::steady_clock::now();
-  detail::OptimizerSettings settings = detail::settings_for_effort(options.effort);
-  settings.regularizer_weight = options.regularizer_weight;
-  settings.seed = options.seed;
-  settings.threads = options.threads;
+  const detail::OptimizerSettings settings = detail::optimizer_settings(options);
   detail::EmbedInput in;
   in.P = &P;
   in.pm = &pm;

@@ -385,6 +385,51 @@ Json sphere_param_options_json(const SphereParamOptions& o) {
   return j;
 }
 
+ConstrainedParamOptions ConstrainedFlags::resolve(const SphereParamOptions& sphere) const {
+  ConstrainedParamOptions o = constrained;
+  o.sphere = sphere;
+  o.unswirl = !no_unswirl;
+  o.edge_flips = !no_flips;
+  o.sidedness = !no_sidedness;
+  return o;
+}
+
+void add_constrained_flags(CLI::App& cmd, ConstrainedFlags& f) {
+  cmd.add_option("--steiner-penalty", f.constrained.steiner_penalty, "cost factor of paths through edge midpoints")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
+  cmd.add_option("--min-angle", f.constrained.min_angle_deg, "defer arcs making smaller angles (degrees)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+  cmd.add_flag("--no-unswirl", f.no_unswirl, "skip the unswirl operator");
+  cmd.add_flag("--no-flips", f.no_flips, "skip path edge flips");
+  cmd.add_flag("--no-sidedness", f.no_sidedness, "skip the sidedness tests");
+}
+
+Json constrained_options_json(const ConstrainedParamOptions& o) {
+  Json j = sphere_param_options_json(o.sphere);
+  j["steiner_penalty"] = o.steiner_penalty;
+  j["min_angle_deg"] = o.min_angle_deg;
+  j["extremity_fraction"] = o.extremity_fraction;
+  j["unswirl"] = o.unswirl;
+  j["edge_flips"] = o.edge_flips;
+  j["sidedness"] = o.sidedness;
+  return j;
+}
+
+Json feature_network_json(const FeatureNetworkReport& n) {
+  return Json{{"auxiliary_features", n.auxiliary_features},
+              {"paths", n.paths},
+              {"total_path_length", n.total_length},
+              {"max_length_ratio", n.max_ratio},
+              {"swirls_fixed", n.swirls_fixed},
+              {"edge_flips", n.edge_flips},
+              {"deferred", n.deferred},
+              {"steiner_vertices", n.steiner_vertices},
+              {"flips_untangled", n.flips_after_steiner_removal},
+              {"attempts", n.attempts}};
+}
+
 Json sphere_param_result_json(const SphereParamResult& r) {
   Json j;
   j["holes_filled"] = r.holes_filled;

@@ -17,6 +17,7 @@
 #include "spherekit/mesh.h"
 #include "spherekit/metrics.h"
 #include "spherekit/progress.h"
+#include "spherekit/constrained_param.h"
 #include "spherekit/sphere_param.h"
 #include "spherekit/status.h"
 
@@ -223,6 +224,20 @@ CLI::App* add_command(CLI::App& app, const std::string& name, const std::string&
 void add_sphere_param_options(CLI::App& command, SphereParamOptions& options);
 /// The options as recorded in reports.
 Json sphere_param_options_json(const SphereParamOptions& options);
+
+/// The constrained stage's flags (param, consistent, add): its options plus the `--no-*`
+/// switches, resolved against the sphere options.
+struct ConstrainedFlags {
+  ConstrainedParamOptions constrained;
+  bool no_unswirl = false, no_flips = false, no_sidedness = false;
+  ConstrainedParamOptions resolve(const SphereParamOptions& sphere) const;
+};
+/// Adds --steiner-penalty, --min-angle, --no-unswirl, --no-flips, --no-sidedness.
+void add_constrained_flags(CLI::App& command, ConstrainedFlags& flags);
+/// The constrained options as recorded in reports (the sphere options plus the network's).
+Json constrained_options_json(const ConstrainedParamOptions& options);
+/// The path network's statistics as recorded in reports.
+Json feature_network_json(const FeatureNetworkReport& network);
 
 /// The measures of a parameterize_sphere() result as recorded in reports (param, run).
 Json sphere_param_result_json(const SphereParamResult& result);

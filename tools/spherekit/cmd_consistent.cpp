@@ -27,42 +27,6 @@ namespace fs = std::filesystem;
 namespace spherekit::cli {
 namespace {
 
-struct ConstrainedFlags {
-  ConstrainedParamOptions constrained;
-  bool no_unswirl = false, no_flips = false, no_sidedness = false;
-  ConstrainedParamOptions resolve(const SphereParamOptions& sphere) const {
-    ConstrainedParamOptions o = constrained;
-    o.sphere = sphere;
-    o.unswirl = !no_unswirl;
-    o.edge_flips = !no_flips;
-    o.sidedness = !no_sidedness;
-    return o;
-  }
-};
-
-void add_constrained_flags(CLI::App& cmd, ConstrainedFlags& f) {
-  cmd.add_option("--steiner-penalty", f.constrained.steiner_penalty, "cost factor of paths through edge midpoints")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 100.0));
-  cmd.add_option("--min-angle", f.constrained.min_angle_deg, "defer arcs making smaller angles (degrees)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 60.0));
-  cmd.add_flag("--no-unswirl", f.no_unswirl, "skip the unswirl operator");
-  cmd.add_flag("--no-flips", f.no_flips, "skip path edge flips");
-  cmd.add_flag("--no-sidedness", f.no_sidedness, "skip the sidedness tests");
-}
-
-Json constrained_options_json(const ConstrainedParamOptions& o) {
-  Json j = sphere_param_options_json(o.sphere);
-  j["steiner_penalty"] = o.steiner_penalty;
-  j["min_angle_deg"] = o.min_angle_deg;
-  j["extremity_fraction"] = o.extremity_fraction;
-  j["unswirl"] = o.unswirl;
-  j["edge_flips"] = o.edge_flips;
-  j["sidedness"] = o.sidedness;
-  return j;
-}
-
 Json map_entry_json(const ConstrainedParamResult& r) {
   Json j;
   j["efficiency"] = r.efficiency;
@@ -73,15 +37,7 @@ Json map_entry_json(const ConstrainedParamResult& r) {
   j["max_feature_angle"] = r.max_feature_angle;
   j["holes_filled"] = r.holes_filled;
   j["method"] = r.map.provenance.method;
-  const auto& n = r.network;
-  j["network"] = Json{{"paths", n.paths},
-                      {"total_path_length", n.total_length},
-                      {"max_length_ratio", n.max_ratio},
-                      {"swirls_fixed", n.swirls_fixed},
-                      {"edge_flips", n.edge_flips},
-                      {"steiner_vertices", n.steiner_vertices},
-                      {"auxiliary_features", n.auxiliary_features},
-                      {"attempts", n.attempts}};
+  j["network"] = feature_network_json(r.network);
   j["times"] = Json{{"network", r.times.network}, {"simplify", r.times.simplify},
                     {"refine", r.times.refine},   {"total", r.times.total}};
   return j;

@@ -27,8 +27,7 @@ struct ParamArgs {
   std::string features;
   std::string targets;
   std::string dump_network;
-  ConstrainedParamOptions constrained;
-  bool no_unswirl = false, no_flips = false, no_sidedness = false;
+  ConstrainedFlags flags;
 };
 
 void print_summary(const ParamArgs& a, const LoadedMesh& m, const SphereParamResult& r, double wall, double cpu,
@@ -104,11 +103,7 @@ int run_constrained(const ParamArgs& a, const LoadedMesh& m, const Stopwatch& wa
     if (std::find(names.begin(), names.end(), p.name) == names.end())
       return print_error(Status(ErrorCode::InvalidInput, strprintf("%s: target '%s' names no feature of %s", a.targets.c_str(),
                                                                    p.name.c_str(), a.features.c_str())));
-  ConstrainedParamOptions o = a.constrained;
-  o.sphere = a.options;
-  o.unswirl = !a.no_unswirl;
-  o.edge_flips = !a.no_flips;
-  o.sidedness = !a.no_sidedness;
+  const ConstrainedParamOptions o = a.flags.resolve(a.options);
 
   ProgressRenderer progress(a.quiet);
   Result<ConstrainedParamResult> result = [&] {
@@ -148,29 +143,14 @@ int run_constrained(const ParamArgs& a, const LoadedMesh& m, const Stopwatch& wa
     j["winding"] = r.winding;
     j["max_feature_angle"] = r.max_feature_angle;
     j["holes_filled"] = r.holes_filled;
-    const auto& n = r.network;
-    j["network"] = Json{{"features", static_cast<int>(fv.size())},
-                        {"auxiliary_features", n.auxiliary_features},
-                        {"paths", n.paths},
-                        {"total_path_length", n.total_length},
-                        {"max_length_ratio", n.max_ratio},
-                        {"swirls_fixed", n.swirls_fixed},
-                        {"edge_flips", n.edge_flips},
-                        {"deferred", n.deferred},
-                        {"steiner_vertices", n.steiner_vertices},
-                        {"flips_untangled", n.flips_after_steiner_removal},
-                        {"attempts", n.attempts}};
+    j["network"] = feature_network_json(r.network);
+    j["network"]["features"] = static_cast<int>(fv.size());
     j["times"] = Json{{"read", m.read_seconds}, {"check", r.times.check},     {"network", r.times.network},
                       {"simplify", r.times.simplify}, {"refine", r.times.refine}, {"total", r.times.total},
                       {"wall", wall_seconds}};
     j["cpu_seconds"] = cpu;
     j["peak_rss_mb"] = peak_mb;
-    j["options"] = sphere_param_options_json(a.options);
-    j["options"]["steiner_penalty"] = o.steiner_penalty;
-    j["options"]["min_angle_deg"] = o.min_angle_deg;
-    j["options"]["unswirl"] = o.unswirl;
-    j["options"]["edge_flips"] = o.edge_flips;
-    j["options"]["sidedness"] = o.sidedness;
+    j["options"] = constrained_options_json(o);
     j["version"] = kVersion;
     j["provenance"] = provenance_json(r.map.provenance);
     if (Status s = write_json_atomic(a.report, j); !s.ok()) return print_error(s);
@@ -282,13 +262,7 @@ void register_param(CLI::App& app) {
   cmd->add_option("--features", args->features, "feature vertices (`name vertex` lines): constrained map");
   cmd->add_option("--targets", args->targets, "their sphere points (`name x y z` unit vectors)");
   cmd->add_option("--dump-network", args->dump_network, "write the path network here (.obj polylines)");
-  cmd->add_option("--steiner-penalty", args->constrained.steiner_penalty,
-                  "cost factor of paths through edge midpoints")->capture_default_str()->check(CLI::Range(1.0, 100.0));
-  cmd->add_option("--min-angle", args->constrained.min_angle_deg,
-                  "defer arcs making smaller angles (degrees)")->capture_default_str()->check(CLI::Range(0.0, 60.0));
-  cmd->add_flag("--no-unswirl", args->no_unswirl, "skip the unswirl operator");
-  cmd->add_flag("--no-flips", args->no_flips, "skip path edge flips");
-  cmd->add_flag("--no-sidedness", args->no_sidedness, "skip the sidedness tests");
+  add_constrained_flags(*cmd, args->flags);
   cmd->callback([args] { set_exit_code(run_param(*args)); });
 }
 

@@ -7,9 +7,21 @@
 #include <cstdio>
 #include <string>
 
+#include "detail/sphere_state.h"
 #include "spherekit/mesh.h"
+#include "spherekit/sphere_param.h"
 
 namespace spherekit::detail {
+
+/// The optimizer settings of a stage: the effort preset plus the options' regularizer,
+/// seed and threads.
+inline OptimizerSettings optimizer_settings(const SphereParamOptions& o) {
+  OptimizerSettings s = settings_for_effort(o.effort);
+  s.regularizer_weight = o.regularizer_weight;
+  s.seed = o.seed;
+  s.threads = o.threads;
+  return s;
+}
 
 inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -9,7 +9,9 @@ build_dir=build
 cmake_args=(-G Ninja -DCMAKE_BUILD_TYPE=Release)
 for arg in "$@"; do
   case "$arg" in
-    --sanitize) build_dir=build-asan; cmake_args=(-G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSPHEREKIT_SANITIZE=ON) ;;
+    # -O1 -g1 (line tables only): what ASan recommends, and about half the compile time of
+    # RelWithDebInfo, which keeps the CI under its 20 minutes on 2 cores.
+    --sanitize) build_dir=build-asan; cmake_args=(-G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" -DSPHEREKIT_SANITIZE=ON) ;;
     -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
     *) echo "build.sh: unknown argument '$arg' (only --sanitize)" >&2; exit 2 ;;
   esac

@@ -67,22 +67,26 @@ Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector
 }
 
 // Spherical Chebyshev centre of v's kernel (maximize min over ring faces of n_f . x, with
-// n_f = S_a x S_b for ring face (v, a, b)) by projected subgradient ascent; true if the point
-// found makes every ring face positive by the exact predicate.
+// n_f = S_a x S_b / |S_a x S_b| for ring face (v, a, b)) by projected subgradient ascent; true
+// if the point found makes every ring face positive by the exact predicate. When the kernel
+// is empty and `compromise` is given, it receives the best max-min point found (some ring
+// faces stay negative there, by as little as possible).
 bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring, const Eigen::Vector3d& start,
-                  Eigen::Vector3d* out) {
+                  Eigen::Vector3d* out, Eigen::Vector3d* compromise = nullptr) {
   std::vector<Eigen::Vector3d> nrm;
   for (const auto& r : ring) {
     Eigen::Vector3d n = S.row(r[0]).transpose().cross(S.row(r[1]).transpose());
     double l = n.norm();
     if (l > 0) nrm.push_back(n / l);
   }
+  if (nrm.empty()) return false;
   auto valid = [&](const Eigen::Vector3d& x) {
     for (const auto& r : ring)
       if (orient3d_origin(x.data(), S.row(r[0]).data(), S.row(r[1]).data()) <= 0) return false;
     return true;
   };
-  Eigen::Vector3d x = start.normalized();
+  Eigen::Vector3d x = start.normalized(), best_x = x;
+  double best_min = -1e300;
   double step = 0.1;
   for (int it = 0; it < 2000; ++it) {
     double best = 1e300;
@@ -100,9 +104,14 @@ bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring
       *out = valid(y) ? y : x;
       return true;
     }
+    if (best > best_min) {
+      best_min = best;
+      best_x = x;
+    }
     x = (x + step * nrm[arg]).normalized();
     step *= 0.995;
   }
+  if (compromise) *compromise = best_x;
   return false;
 }
 
@@ -128,8 +137,11 @@ struct FaceSet {
 
 // Local untangling: moves the free corners of the given flipped faces (and, when that is not
 // enough, vertices in growing rings around them) to points inside their spherical kernels.
-// Returns true when no face around them is flipped any more.
-bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int> bad, RowMat3d* S) {
+// A vertex whose kernel is empty stays, unless `soft`: then it goes to its best compromise
+// point (see kernel_point), which lets a fold that no single vertex can undo unfold over
+// successive sweeps. Returns true when no face around them is flipped any more.
+bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int> bad, RowMat3d* S,
+              bool soft = false) {
   for (int sweep = 0; sweep < 120 && !bad.empty(); ++sweep) {
     std::vector<int> cand;
     for (int f : bad)
@@ -156,8 +168,10 @@ bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int
         ring.push_back({a, b});
         mean += S->row(a).transpose();
       }
-      Eigen::Vector3d x;
-      if (mean.norm() > 0 && kernel_point(*S, ring, mean, &x)) S->row(v) = x.transpose();
+      Eigen::Vector3d x, y;
+      if (!(mean.norm() > 0)) continue;
+      if (kernel_point(*S, ring, mean, &x, soft ? &y : nullptr)) S->row(v) = x.transpose();
+      else if (soft) S->row(v) = y.transpose();
     }
     std::vector<int> still;
     for (int v : cand)
@@ -168,6 +182,24 @@ bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int
     bad.swap(still);
   }
   return bad.empty();
+}
+
+std::vector<int> flipped_faces(const FaceSet& fs, const RowMat3d& S) {
+  std::vector<int> bad;
+  for (size_t f = 0; f < fs.F.size(); ++f)
+    if (fs.alive[f] && fs.flipped(S, static_cast<int>(f))) bad.push_back(static_cast<int>(f));
+  return bad;
+}
+
+// Untangling of a fold: a thin input face whose two Steiner-split halves bulged across a path
+// comes back inverted with every corner's kernel empty, so no single vertex move repairs it.
+// The soft untangling moves such corners to their best compromise points and lets the
+// neighbourhood follow. On failure S is restored (a soft sweep may have spread the fold).
+bool untangle_fold(const FaceSet& fs, const std::vector<char>& fixed, const std::vector<int>& bad, RowMat3d* S) {
+  const RowMat3d saved = *S;
+  if (untangle(fs, fixed, bad, S, /*soft=*/true)) return true;
+  *S = saved;
+  return false;
 }
 
 // Undoes the network's edge splits in reverse order on the map: each undo merges two pairs of
@@ -196,14 +228,14 @@ int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<ch
     }
     if (!merged.empty()) {
       ++untangled;
-      untangle(fs, fixed_all, merged, S);  // a face left flipped here may be merged again below
+      // A face left flipped here may still be merged again below.
+      if (!untangle(fs, fixed_all, merged, S)) untangle_fold(fs, fixed_all, flipped_faces(fs, *S), S);
     }
   }
   // Whatever is still flipped at the end: untangle once more over the final faces.
-  std::vector<int> bad;
-  for (size_t f = 0; f < fs.F.size(); ++f)
-    if (fs.alive[f] && fs.flipped(*S, static_cast<int>(f))) bad.push_back(static_cast<int>(f));
-  if (!bad.empty() && !untangle(fs, fixed_all, bad, S)) return -1;
+  std::vector<int> bad = flipped_faces(fs, *S);
+  if (!bad.empty() && !untangle(fs, fixed_all, bad, S) && !untangle_fold(fs, fixed_all, flipped_faces(fs, *S), S))
+    return -1;
   return untangled;
 }
 

@@ -17,30 +17,12 @@
 #include <string>
 #include <vector>
 
+#include "exr_memory_stream.h"
 #include "spherekit/formats/atomic_file.h"
 #include "spherekit/version.h"
 
 namespace spherekit::convert {
 namespace {
-
-// An Imf::OStream that collects the file in memory.
-class MemoryStream final : public Imf::OStream {
- public:
-  MemoryStream() : Imf::OStream("<memory>") {}
-  void write(const char c[], int n) override {
-    const std::size_t end = pos_ + static_cast<std::size_t>(n);
-    if (end > bytes_.size()) bytes_.resize(end);
-    std::memcpy(bytes_.data() + pos_, c, static_cast<std::size_t>(n));
-    pos_ = end;
-  }
-  uint64_t tellp() override { return pos_; }
-  void seekp(uint64_t pos) override { pos_ = static_cast<std::size_t>(pos); }
-  std::string& bytes() { return bytes_; }
-
- private:
-  std::string bytes_;
-  std::size_t pos_ = 0;
-};
 
 const char* const kPositionChannels[3] = {"R", "G", "B"};
 const char* const kNormalChannels[3] = {"N.X", "N.Y", "N.Z"};
@@ -92,7 +74,7 @@ Status write_geometry_image_exr(const std::string& path, const GeometryImage& im
                                        sizeof(std::uint32_t) * static_cast<std::size_t>(n)));
     fb.insert(kHoleChannel, Imf::Slice(Imf::UINT, reinterpret_cast<char*>(holes.data()), sizeof(std::uint32_t),
                                        sizeof(std::uint32_t) * static_cast<std::size_t>(n)));
-    MemoryStream stream;
+    detail::MemoryStream stream;
     {
       Imf::OutputFile file(stream, header, 1);
       file.setFrameBuffer(fb);

@@ -11,7 +11,11 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "convert_common.h"
+#include "spherekit/convert/displacement.h"
+#include "spherekit/convert/displacement_exr.h"
 #include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/convert/subd_cage.h"
 #include "spherekit/convert/gltf_lods.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
@@ -20,22 +24,7 @@
 #include "spherekit/version.h"
 
 namespace spherekit::cli {
-namespace {
 
-struct ConvertArgs {
-  std::string mesh;
-  std::string sphere;
-  std::string output;
-  std::string remesh;
-  std::string report;
-  int size = 257;
-  int psnr_samples = RemeshErrorOptions{}.samples;
-  int lods = 0;  // glTF levels of detail (0: none)
-  convert::QuantizationBudget budget;
-  bool quiet = false;
-};
-
-// OUT.exr -> OUT (the glTF files are OUT_lod0.glb ... and OUT_lods.glb).
 std::string gltf_prefix(const std::string& output) {
   const std::size_t slash = output.find_last_of('/'), dot = output.find_last_of('.');
   if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) return output.substr(0, dot);
@@ -50,17 +39,108 @@ std::uintmax_t file_bytes(const std::string& path) {
 
 Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
-int run_convert(const ConvertArgs& a) {
-  // Flags first: a bad size must fail before anything is read or written.
+Status check_convert_flags(const ConvertArgs& a) {
   if (!is_geometry_image_size(a.size) || a.size > 16385)
-    return print_error(Status(ErrorCode::InvalidArgument,
-                              strprintf("--size %d is not 2^k+1 (e.g. 65, 129, 257, 513)", a.size)));
-  if (a.psnr_samples < 0)
-    return print_error(Status(ErrorCode::InvalidArgument, "--psnr-samples must be >= 0"));
+    return Status(ErrorCode::InvalidArgument, strprintf("--size %d is not 2^k+1 (e.g. 65, 129, 257, 513)", a.size));
+  if (a.psnr_samples < 0) return Status(ErrorCode::InvalidArgument, "--psnr-samples must be >= 0");
   if (a.lods < 0 || a.lods > 30 || (a.lods > 0 && ((a.size - 1) >> (a.lods - 1)) < 2))
-    return print_error(Status(ErrorCode::InvalidArgument,
-                              strprintf("--lods %d does not fit --gi %d (the coarsest level needs >= 3 x 3 texels)",
-                                        a.lods, a.size)));
+    return Status(ErrorCode::InvalidArgument,
+                  strprintf("--lods %d does not fit --gi %d (the coarsest level needs >= 3 x 3 texels)", a.lods, a.size));
+  if (a.cage < 0 || a.cage > 256)
+    return Status(ErrorCode::InvalidArgument, strprintf("--cage %d is not in 0..256", a.cage));
+  if (a.cage_tile < 2 || a.cage_tile > 1025)
+    return Status(ErrorCode::InvalidArgument, strprintf("--cage-tile %d is not in 2..1025", a.cage_tile));
+  if (a.displacement != "scalar" && a.displacement != "vector")
+    return Status(ErrorCode::InvalidArgument, "--displacement must be scalar or vector, not '" + a.displacement + "'");
+  if (a.collection.empty() && (a.mesh.empty() || a.sphere.empty()))
+    return Status(ErrorCode::InvalidArgument, "give MESH and SPHERE, or --collection DIR");
+  if (!a.collection.empty() && (!a.mesh.empty() || !a.sphere.empty()))
+    return Status(ErrorCode::InvalidArgument, "--collection converts every member: give no MESH or SPHERE with it");
+  if (!a.collection.empty() && !a.remesh.empty())
+    return Status(ErrorCode::InvalidArgument, "--remesh is for one mesh; with --collection use --report");
+  return Status();
+}
+
+// Fits the cage, samples the displacement, writes both, and measures the bare limit surface
+// and the displaced surface against the mesh (hole spans left out, as for the image).
+Result<CageOutput> build_cage(const TriMesh& mesh, const RowMat3d& S, const ConvertArgs& a, const std::string& prefix,
+                              const ProgressFn& progress) {
+  Stopwatch time;
+  CageOutput out;
+  auto domain = convert::cube_cage_domain(a.cage);
+  if (!domain.ok()) return domain.status();
+  auto limit = convert::CageLimit::create(domain.value());
+  if (!limit.ok()) return limit.status();
+  auto cage = convert::fit_subd_cage(mesh, S, limit.value(), domain.value(), {}, progress);
+  if (!cage.ok()) return cage.status();
+  convert::DisplacementOptions dopt;
+  dopt.tile = a.cage_tile;
+  dopt.kind = a.displacement == "vector" ? convert::DisplacementKind::Vector : convert::DisplacementKind::Scalar;
+  auto disp = convert::sample_displacement(mesh, S, cage.value(), limit.value(), dopt, progress);
+  if (!disp.ok()) return disp.status();
+  out.cage_path = prefix + "_cage.obj";
+  out.displacement_path = prefix + "_disp.exr";
+  if (Status s = convert::write_cage_obj(out.cage_path, cage.value(), "fitted to " + a.mesh); !s.ok()) return s;
+  if (Status s = convert::write_displacement_exr(out.displacement_path, disp.value(),
+                                                 {a.mesh, a.sphere, out.cage_path});
+      !s.ok())
+    return s;
+  out.n = a.cage;
+  out.tile = a.cage_tile;
+  out.kind = a.displacement;
+  out.control_points = static_cast<int>(cage->points.rows());
+  out.quads = static_cast<int>(cage->domain.quads.size());
+  out.fit_rms = cage->fit_rms;
+  out.max_displacement = disp->max_abs;
+  out.ray_residual = disp->mean_ray_residual;
+  out.samples_in_holes = disp->samples_in_holes;
+  out.stored_floats = convert::stored_floats(cage.value(), disp.value());
+  out.seconds = time.seconds();
+  if (a.psnr_samples > 0) {
+    Stopwatch t;
+    RemeshErrorOptions opts;
+    opts.samples = a.psnr_samples;
+    std::vector<std::uint8_t> holes;
+    const TriMesh displaced = convert::displaced_surface_mesh(cage.value(), limit.value(), &disp.value(), 0, &holes);
+    out.displaced_error = remesh_error(mesh, displaced, opts, holes);
+    const TriMesh limit_mesh = convert::displaced_surface_mesh(cage.value(), limit.value(), nullptr, a.cage_tile);
+    out.limit_error = remesh_error(mesh, limit_mesh, opts, holes);
+    out.measured = true;
+    out.psnr_seconds = t.seconds();
+  }
+  return out;
+}
+
+Json cage_json(const CageOutput& c) {
+  Json j;
+  j["file"] = c.cage_path;
+  j["displacement_file"] = c.displacement_path;
+  j["domain"] = "cube, equi-angular";
+  j["n"] = c.n;
+  j["quads"] = c.quads;
+  j["control_points"] = c.control_points;
+  j["displacement"] = c.kind;
+  j["tile"] = c.tile;
+  j["fit_rms"] = c.fit_rms;
+  j["max_displacement"] = c.max_displacement;
+  if (c.kind == "scalar") j["mean_ray_residual"] = c.ray_residual;
+  j["samples_in_holes"] = c.samples_in_holes;
+  j["stored_floats"] = c.stored_floats;
+  j["bytes"] = file_bytes(c.cage_path) + file_bytes(c.displacement_path);
+  if (c.measured) {
+    j["psnr_db_limit"] = number_or_null(c.limit_error.psnr);
+    j["psnr_db"] = number_or_null(c.displaced_error.psnr);
+    j["rms"] = c.displaced_error.rms;
+  }
+  return j;
+}
+
+namespace {
+
+int run_convert(const ConvertArgs& a) {
+  if (!a.collection.empty()) return run_convert_collection(a);
+  // Flags first: a bad size must fail before anything is read or written.
+  if (Status s = check_convert_flags(a); !s.ok()) return print_error(s);
 
   // Every output folder before any work: a bad --report path must not fail the command
   // after the image was written.
@@ -154,6 +234,15 @@ int run_convert(const ConvertArgs& a) {
       gltf_psnr_seconds = t.seconds();
     }
   }
+  // Catmull-Clark cage + displacement atlas: OUT_cage.obj, OUT_disp.exr.
+  CageOutput cage_out;
+  if (a.cage > 0) {
+    ProgressRenderer progress(a.quiet, file_stem(a.mesh));
+    auto built = build_cage(m.mesh, map->S, a, gltf_prefix(a.output), progress.callback());
+    progress.finish();
+    if (!built.ok()) return print_error(with_file(built.status(), a.mesh));
+    cage_out = std::move(built).value();
+  }
   const double wall_seconds = wall.seconds();
 
   if (!a.report.empty()) {
@@ -211,6 +300,11 @@ int run_convert(const ConvertArgs& a) {
       j["times"]["gltf"] = gltf_seconds;
       j["times"]["gltf_psnr"] = gltf_psnr_seconds;
     }
+    if (a.cage > 0) {
+      j["cage"] = cage_json(cage_out);
+      j["times"]["cage"] = cage_out.seconds;
+      j["times"]["cage_psnr"] = cage_out.psnr_seconds;
+    }
     j["times"]["read"] = read_seconds;
     j["times"]["sample"] = sample_seconds;
     j["times"]["remesh"] = remesh_seconds;
@@ -250,6 +344,15 @@ int run_convert(const ConvertArgs& a) {
       std::printf("    %s  all levels (MSFT_lod) %llu bytes\n", lod_paths.combined.c_str(),
                   static_cast<unsigned long long>(file_bytes(lod_paths.combined)));
     }
+    if (a.cage > 0) {
+      std::printf("  cage %s: %d quads, %d control points (fit rms %.3g); %s displacement %d x %d per quad -> %s",
+                  cage_out.cage_path.c_str(), cage_out.quads, cage_out.control_points, cage_out.fit_rms,
+                  cage_out.kind.c_str(), cage_out.tile, cage_out.tile, cage_out.displacement_path.c_str());
+      if (cage_out.measured)
+        std::printf("\n    PSNR limit surface %.2f dB, displaced %.2f dB (%lld floats stored)",
+                    cage_out.limit_error.psnr, cage_out.displaced_error.psnr, cage_out.stored_floats);
+      std::printf("  %.2f s\n", cage_out.seconds);
+    }
     std::printf("  time: read %.2f s, sample %.3f s, remesh %.3f s, write %.2f s, PSNR %.2f s, %stotal %.2f s\n",
                 read_seconds, sample_seconds, remesh_seconds, write_seconds, psnr_seconds,
                 a.lods > 0 ? strprintf("glTF %.2f s + PSNR %.2f s, ", gltf_seconds, gltf_psnr_seconds).c_str() : "",
@@ -277,15 +380,35 @@ void register_convert(CLI::App& app) {
       "the fewest >= --min-position-bits whose quantization error is at most a tenth of the\n"
       "measured remesh error (recorded in the glTF extras and the report, with each level's\n"
       "size and the PSNR of its decoded geometry). The mesh must be one `param` accepts and the\n"
-      "map a bijection (no face flipped by the exact predicate). Exit codes: 2 bad flags (e.g.\n"
+      "map a bijection (no face flipped by the exact predicate).\n"
+      "With --cage N it also fits a Catmull-Clark base cage defined on the sphere domain (the\n"
+      "cube, N x N quads per face, 6N^2 quads, the same for every mesh: in a consistent\n"
+      "collection cage vertex k is the same place on every member) whose limit surface\n"
+      "(OpenSubdiv) best fits the mesh, writes it as OUT_cage.obj, and samples the displacement\n"
+      "from the limit surface to the mesh on a T x T grid per quad (--cage-tile T), packed into\n"
+      "one EXR atlas OUT_disp.exr (layout in its header; see README). It reports the PSNR of the\n"
+      "bare limit surface and of the displaced one.\n"
+      "With --collection DIR (instead of MESH SPHERE) every member of a consistent collection is\n"
+      "converted with the same options into the folder -o: NAME.exr, NAME_lod*.glb, NAME_cage.obj,\n"
+      "NAME_disp.exr per member, collection_morph.glb (one glTF, the members as morph targets),\n"
+      "and convert_report.json (per member sizes and PSNRs, and per feature the texel that holds\n"
+      "it in every image). All members share one layout: the same texel, cage vertex, glTF\n"
+      "vertex is the same place on every member. The folder appears only when complete.\n"
+      "Exit codes: 2 bad flags (e.g.\n"
       "--size not 2^k+1), 3 bad input (including a folded map), 4 I/O error.",
       "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr\n"
       "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr --size 129 --remesh bunny.gim.obj\n"
       "  spherekit convert igea.ply igea.sphere.obj -o igea.exr --report igea.convert.json\n"
-      "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --gi 257 --lods 4");
-  cmd->add_option("MESH", args->mesh, "input mesh (.obj .ply .off .stl .gltf .glb)")->required();
-  cmd->add_option("SPHERE", args->sphere, "its sphere map (.obj, from `spherekit param`)")->required();
-  cmd->add_option("-o,--output", args->output, "geometry image to write (.exr)")->required();
+      "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --gi 257 --lods 4\n"
+      "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --cage 8 --cage-tile 33\n"
+      "  spherekit convert --collection heads/ -o heads_assets/ --gi 129 --lods 3 --cage 8");
+  cmd->add_option("MESH", args->mesh, "input mesh (.obj .ply .off .stl .gltf .glb)");
+  cmd->add_option("SPHERE", args->sphere, "its sphere map (.obj, from `spherekit param`)");
+  cmd->add_option("--collection", args->collection,
+                  "instead of MESH SPHERE: convert every member of this collection folder (from `spherekit "
+                  "consistent`) into the folder -o");
+  cmd->add_option("-o,--output", args->output, "geometry image to write (.exr); with --collection: a folder")
+      ->required();
   cmd->add_option("--size,--gi", args->size, "image size N = 2^k+1 (default 257)");
   cmd->add_option("--remesh", args->remesh, "also write the remesh defined by the image (.obj .ply)");
   cmd->add_option("--report", args->report, "also write a JSON report here");
@@ -297,6 +420,12 @@ void register_convert(CLI::App& app) {
   cmd->add_option("--normal-bits", args->budget.normal_bits, "glTF: Draco normal bits (default 10)");
   cmd->add_option("--min-texcoord-bits", args->budget.min_texcoord_bits,
                   "glTF: fewest Draco texture-coordinate bits (default 12)");
+  cmd->add_option("--cage", args->cage,
+                  "also fit a Catmull-Clark cage with N x N quads per cube face (OUT_cage.obj) and sample "
+                  "its displacement map (OUT_disp.exr); default 0: none");
+  cmd->add_option("--cage-tile", args->cage_tile, "displacement samples per cage-quad edge (default 17)");
+  cmd->add_option("--displacement", args->displacement,
+                  "scalar (along the limit normal, 1 float per sample; default) or vector (3 floats)");
   cmd->add_flag("-q,--quiet", args->quiet, "print no summary (errors still)");
   cmd->callback([args] { set_exit_code(run_convert(*args)); });
 }

@@ -18,9 +18,9 @@ Status bad(const std::string& file, const std::string& what) {
   return Status(ErrorCode::InvalidInput, file + ": " + what);
 }
 
-bool is_collection(const fs::path& dir) {
+bool has_marker(const fs::path& dir, const char* marker) {
   std::error_code ec;
-  return fs::is_regular_file(dir / kCollectionManifest, ec);
+  return fs::is_regular_file(dir / marker, ec);
 }
 
 bool is_empty_dir(const fs::path& dir) {
@@ -85,19 +85,28 @@ int find_member(const CollectionInfo& c, const std::string& mesh_path) {
   return by_stem;
 }
 
-Status require_collection_target(const std::string& dir) {
+Status require_collection_target(const std::string& dir) { return require_staged_folder_target(dir, kCollectionManifest); }
+
+Status require_staged_folder_target(const std::string& dir, const char* marker) {
   std::error_code ec;
   const fs::path p(dir);
   const fs::path parent = fs::absolute(p, ec).parent_path();
   if (!fs::is_directory(parent, ec)) return Status(ErrorCode::IoError, dir + ": parent folder does not exist");
   if (!fs::exists(p, ec)) return Status();
   if (!fs::is_directory(p, ec)) return Status(ErrorCode::IoError, dir + ": exists and is not a folder");
-  if (is_empty_dir(p) || is_collection(p)) return Status();
-  return Status(ErrorCode::IoError, dir + ": folder is not empty and not a collection; refusing to replace it");
+  if (is_empty_dir(p) || has_marker(p, marker)) return Status();
+  if (std::string(marker) == kCollectionManifest)
+    return Status(ErrorCode::IoError, dir + ": folder is not empty and not a collection; refusing to replace it");
+  return Status(ErrorCode::IoError, dir + ": folder is not empty and has no " + marker + "; refusing to replace it");
 }
 
 Status write_collection_folder(const std::string& dir, const std::function<Status(const std::string&)>& write_into) {
-  SPHEREKIT_RETURN_IF_ERROR(require_collection_target(dir));
+  return write_staged_folder(dir, kCollectionManifest, write_into);
+}
+
+Status write_staged_folder(const std::string& dir, const char* marker,
+                           const std::function<Status(const std::string&)>& write_into) {
+  SPHEREKIT_RETURN_IF_ERROR(require_staged_folder_target(dir, marker));
   std::error_code ec;
   const fs::path target = fs::absolute(dir, ec).lexically_normal();
   const fs::path base = target.has_filename() ? target : target.parent_path();
@@ -128,7 +137,7 @@ Status write_collection_folder(const std::string& dir, const std::function<Statu
     const std::string why = ec.message();
     if (had_old) fs::rename(old, base, ec);
     fs::remove_all(staging, ec);
-    return Status(ErrorCode::IoError, dir + ": cannot move the new collection into place (" + why + ")");
+    return Status(ErrorCode::IoError, dir + ": cannot move the new folder into place (" + why + ")");
   }
   if (had_old) fs::remove_all(old, ec);
   return Status();

@@ -46,6 +46,13 @@ Status write_collection_folder(const std::string& dir, const std::function<Statu
 /// its parent exists. Checked before any work.
 Status require_collection_target(const std::string& dir);
 
+/// The same two for any command that writes a whole folder whose files are produced by
+/// writers that take paths (e.g. `convert --collection`): `marker` is the file identifying a
+/// folder the command wrote before (and may replace).
+Status require_staged_folder_target(const std::string& dir, const char* marker);
+Status write_staged_folder(const std::string& dir, const char* marker,
+                           const std::function<Status(const std::string&)>& write_into);
+
 /// `name x y z` lines with 17 significant digits.
 std::string sphere_points_text(const std::vector<std::string>& names, const std::vector<Eigen::Vector3d>& points);
 

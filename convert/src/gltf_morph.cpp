@@ -6,6 +6,7 @@
 // KHR_draco_mesh_compression README; ALGORITHM.md §7 gotcha 9.
 #include "spherekit/convert/gltf_morph.h"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -29,6 +30,45 @@ Status same_connectivity(const GltfMesh& base, const GltfMesh& m, std::size_t k)
   if (m.UV.rows() != base.UV.rows() || m.UV != base.UV)
     return Status(ErrorCode::InvalidInput, who + " has texture coordinates that differ from member 0's");
   return Status();
+}
+
+/// glTF 2.0 "Animations": a sampler whose input is the key times (SCALAR floats with min/max)
+/// and whose output holds, per key, one weight per morph target; the channel targets the
+/// node's "weights" path. Key k shows member k: all weights 0 (the base) for k = 0, else
+/// weight 1 on target k-1.
+void add_weight_animation(detail::GlbBuilder& doc, std::size_t members, double seconds) {
+  const std::size_t targets = members - 1;
+  std::vector<float> times(members), weights(members * targets, 0.0f);
+  for (std::size_t k = 0; k < members; ++k) {
+    times[k] = static_cast<float>(seconds * static_cast<double>(k) / static_cast<double>(targets));
+    if (k > 0) weights[k * targets + (k - 1)] = 1.0f;
+  }
+  auto scalar_accessor = [&](const std::vector<float>& values, bool bounds) {
+    tinygltf::Accessor a;
+    a.bufferView = doc.add_buffer_view(values.data(), values.size() * sizeof(float), 0);
+    a.componentType = detail::kFloat;
+    a.type = TINYGLTF_TYPE_SCALAR;
+    a.count = values.size();
+    if (bounds) {
+      a.minValues = {*std::min_element(values.begin(), values.end())};
+      a.maxValues = {*std::max_element(values.begin(), values.end())};
+    }
+    doc.model().accessors.push_back(std::move(a));
+    return static_cast<int>(doc.model().accessors.size()) - 1;
+  };
+  tinygltf::AnimationSampler sampler;
+  sampler.input = scalar_accessor(times, true);
+  sampler.output = scalar_accessor(weights, false);
+  sampler.interpolation = "LINEAR";
+  tinygltf::AnimationChannel channel;
+  channel.sampler = 0;
+  channel.target_node = 0;
+  channel.target_path = "weights";
+  tinygltf::Animation animation;
+  animation.name = "morph";
+  animation.samplers.push_back(std::move(sampler));
+  animation.channels.push_back(std::move(channel));
+  doc.model().animations.push_back(std::move(animation));
 }
 
 }  // namespace
@@ -110,6 +150,7 @@ Result<GltfMorph> build_gltf_morph_targets(const std::vector<GltfMesh>& members,
   node.name = options.name;
   node.mesh = mesh_index;
   doc.model().nodes.push_back(std::move(node));
+  if (options.animation_seconds > 0 && members.size() >= 2) add_weight_animation(doc, members.size(), options.animation_seconds);
   doc.model().scenes.emplace_back();
   doc.model().scenes[0].nodes = {0};
   doc.model().defaultScene = 0;

@@ -6,13 +6,17 @@
 #include <string>
 #include <string_view>
 
+#include "spherekit/formats/mesh_attributes.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/sphere_map.h"
 
 namespace spherekit::formats::detail {
 
-Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
-Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
+/// `attributes` (optional): also collect what mesh_attributes.h describes.
+Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info,
+                         MeshAttributes* attributes = nullptr);
+Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info,
+                         MeshAttributes* attributes = nullptr);
 Result<TriMesh> read_off(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
 Result<TriMesh> read_stl(const std::string& path, std::string_view bytes, const ReadOptions& options, ReadInfo& info);
 /// `glb`: binary container (.glb) rather than JSON text (.gltf). External buffers are
@@ -28,8 +32,11 @@ Result<TriMesh> parse_mesh(const std::string& path, std::string_view bytes, cons
 Result<SphereMap> parse_sphere_map(const std::string& path, std::string_view bytes, const TriMesh& mesh);
 
 /// OBJ text: `header` (already '#'-commented lines) first, then `v` lines and 1-based `f` lines.
-std::string format_obj(const TriMesh& mesh, int precision, const std::string& header);
-/// PLY: binary little endian with double coordinates and int indices, or ascii.
-std::string format_ply(const TriMesh& mesh, bool binary, int precision);
+/// `attributes` (optional, already checked): colours, `vt`, `vn`, mtllib/usemtl.
+std::string format_obj(const TriMesh& mesh, int precision, const std::string& header,
+                       const MeshAttributes* attributes = nullptr);
+/// PLY: binary little endian with double coordinates and int indices, or ascii; with
+/// `attributes` colours as uchar red, green, blue.
+std::string format_ply(const TriMesh& mesh, bool binary, int precision, const MeshAttributes* attributes = nullptr);
 
 }  // namespace spherekit::formats::detail

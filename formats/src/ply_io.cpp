@@ -1,7 +1,8 @@
 // Stanford PLY: ascii, binary_little_endian and binary_big_endian.
 // Reads x, y, z of the `vertex` element (any numeric type) and the `vertex_indices` (or
-// `vertex_index`) list of the `face` element (any count and index integer types); every
-// other property and element is skipped by its declared size. Writes doubles and ints.
+// `vertex_index`) list of the `face` element (any count and index integer types), and when
+// asked for (mesh_attributes.h) the vertex colours red, green, blue; every other property
+// and element is skipped by its declared size. Writes doubles and ints (and uchar colours).
 //
 // Hostile files: the header's element counts are never trusted for allocation (reserves
 // are clamped by the bytes actually left), every binary read is bounds-checked, and every
@@ -153,7 +154,22 @@ Result<PlyHeader> parse_header(const std::string& path, std::string_view bytes) 
 }
 
 /// What a property means to us.
-enum class Role { Skip, X, Y, Z, FaceIndices };
+enum class Role { Skip, X, Y, Z, FaceIndices, Red, Green, Blue };
+
+/// Colour integers are fractions of their type's largest value (uchar 255 = 1.0).
+double color_scale(PlyType t) {
+  switch (t) {
+    case PlyType::Int8:
+    case PlyType::UInt8: return 1.0 / 255;
+    case PlyType::Int16:
+    case PlyType::UInt16: return 1.0 / 65535;
+    case PlyType::Int32:
+    case PlyType::UInt32: return 1.0 / 4294967295.0;
+    case PlyType::Float32:
+    case PlyType::Float64: return 1.0;
+  }
+  return 1.0;
+}
 
 enum class ReadResult { Ok, End, Bad };
 
@@ -276,7 +292,7 @@ struct Misalignment {
 
 template <class Source>
 Status read_body(const std::string& path, const PlyHeader& header, const char* kind, Source& src,
-                 MeshBuilder& builder, Misalignment& misaligned) {
+                 MeshBuilder& builder, Misalignment& misaligned, std::vector<double>* colors) {
   std::vector<std::int64_t> corners;
   std::vector<Role> roles;
   for (const PlyElement& e : header.elements) {
@@ -289,6 +305,8 @@ Status read_body(const std::string& path, const PlyHeader& header, const char* k
         roles[k] = p.name == "x" ? Role::X : p.name == "y" ? Role::Y : Role::Z;
       } else if (is_face && p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
         roles[k] = Role::FaceIndices;
+      } else if (colors && is_vertex && !p.is_list && (p.name == "red" || p.name == "green" || p.name == "blue")) {
+        roles[k] = p.name == "red" ? Role::Red : p.name == "green" ? Role::Green : Role::Blue;
       }
     }
     const std::size_t fit =
@@ -297,7 +315,7 @@ Status read_body(const std::string& path, const PlyHeader& header, const char* k
     if (is_face) builder.reserve(0, fit);
 
     for (std::uint64_t i = 0; i < e.count; ++i) {
-      double xyz[3] = {0, 0, 0};
+      double xyz[3] = {0, 0, 0}, rgb[3] = {0, 0, 0};
       for (std::size_t k = 0; k < e.properties.size(); ++k) {
         const PlyProperty& p = e.properties[k];
         ReadResult r = ReadResult::Ok;
@@ -318,6 +336,10 @@ Status read_body(const std::string& path, const PlyHeader& header, const char* k
           } else if (r == ReadResult::Ok) {
             r = src.skip(p.type, static_cast<std::uint64_t>(n));
           }
+        } else if (roles[k] == Role::Red || roles[k] == Role::Green || roles[k] == Role::Blue) {
+          double& c = rgb[static_cast<int>(roles[k]) - static_cast<int>(Role::Red)];
+          r = src.real(p.type, c);
+          c *= color_scale(p.type);
         } else if (roles[k] != Role::Skip) {
           r = src.real(p.type, xyz[static_cast<int>(roles[k]) - static_cast<int>(Role::X)]);
         } else {
@@ -339,6 +361,7 @@ Status read_body(const std::string& path, const PlyHeader& header, const char* k
         }
       }
       if (is_vertex) SPHEREKIT_RETURN_IF_ERROR(builder.add_vertex(xyz[0], xyz[1], xyz[2]));
+      if (is_vertex && colors) colors->insert(colors->end(), rgb, rgb + 3);
       if (is_face) SPHEREKIT_RETURN_IF_ERROR(builder.add_face(corners.data(), corners.size(), FaceSource::element(i)));
     }
   }
@@ -372,16 +395,25 @@ Status check_layout(const std::string& path, const PlyHeader& header) {
 }  // namespace
 
 Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const ReadOptions& options,
-                         ReadInfo& info) {
+                         ReadInfo& info, MeshAttributes* attributes) {
   SPHEREKIT_ASSIGN_OR_RETURN(PlyHeader header, parse_header(path, bytes));
   SPHEREKIT_RETURN_IF_ERROR(check_layout(path, header));
   const std::string_view body = bytes.substr(header.body_offset);
   MeshBuilder builder(path, options.polygons);
+  // Colours only if the vertex element has all three channels.
+  std::vector<double> colors;
+  int channels = 0;
+  for (const PlyElement& e : header.elements) {
+    if (e.name != "vertex") continue;
+    for (const PlyProperty& p : e.properties)
+      channels += !p.is_list && (p.name == "red" || p.name == "green" || p.name == "blue");
+  }
+  std::vector<double>* want_colors = attributes && channels == 3 ? &colors : nullptr;
   if (header.format == PlyFormat::Ascii) {
     info.format = "ply-ascii";
     AsciiSource src(body, header.body_line);
     Misalignment misaligned;
-    Status read = read_body(path, header, "ascii", src, builder, misaligned);
+    Status read = read_body(path, header, "ascii", src, builder, misaligned, want_colors);
     if (read.ok() && src.has_trailing_data()) {
       read = Status(ErrorCode::ParseError, path + ":" + std::to_string(src.line()) +
                                                ": data after the last element (wrong counts in header?)");
@@ -392,28 +424,39 @@ Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const 
     info.format = big ? "ply-binary-be" : "ply-binary-le";
     BinarySource src(body, big);
     Misalignment unused;  // binary data has no lines
-    SPHEREKIT_RETURN_IF_ERROR(read_body(path, header, "binary", src, builder, unused));
+    SPHEREKIT_RETURN_IF_ERROR(read_body(path, header, "binary", src, builder, unused, want_colors));
     if (std::size_t extra = src.trailing_data(body)) {
       return Status(ErrorCode::ParseError, path + ": binary PLY has " + std::to_string(extra) +
                                                " bytes after the last element (wrong counts in header?)");
     }
   }
-  return builder.finish(info);
+  SPHEREKIT_ASSIGN_OR_RETURN(TriMesh mesh, builder.finish(info));
+  if (want_colors && static_cast<Eigen::Index>(colors.size()) == 3 * mesh.V.rows())
+    attributes->colors = Eigen::Map<const RowMat3d>(colors.data(), mesh.V.rows(), 3);
+  return mesh;
 }
 
-std::string format_ply(const TriMesh& mesh, bool binary, int precision) {
+std::string format_ply(const TriMesh& mesh, bool binary, int precision, const MeshAttributes* attributes) {
+  const bool colors = attributes && attributes->colors.rows() == mesh.V.rows() && mesh.V.rows() > 0;
+  // 0..1 -> 0..255, rounded to nearest and clamped (what viewers expect from uchar colours).
+  auto channel = [&](std::size_t i, int k) {
+    const double c = attributes->colors(static_cast<Eigen::Index>(i), k) * 255.0 + 0.5;
+    return static_cast<std::uint8_t>(c <= 0 ? 0 : c >= 255 ? 255 : c);
+  };
   const auto nv = static_cast<std::size_t>(mesh.V.rows()), nf = static_cast<std::size_t>(mesh.F.rows());
   std::string out = "ply\nformat ";
   out += binary ? "binary_little_endian 1.0\n" : "ascii 1.0\n";
   out += std::string("comment written by spherekit ") + kVersion + "\n";
   out += "element vertex " + std::to_string(nv) + "\n";
   out += "property double x\nproperty double y\nproperty double z\n";
+  if (colors) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   out += "element face " + std::to_string(nf) + "\n";
   out += "property list uchar int vertex_indices\nend_header\n";
   if (binary) {
     out.reserve(out.size() + nv * 24 + nf * 13);
     for (std::size_t i = 0; i < nv; ++i) {
       for (int k = 0; k < 3; ++k) append_le(out, mesh.V(static_cast<Eigen::Index>(i), k));
+      for (int k = 0; colors && k < 3; ++k) append_le(out, channel(i, k));
     }
     for (std::size_t i = 0; i < nf; ++i) {
       append_le(out, std::uint8_t{3});
@@ -426,6 +469,10 @@ std::string format_ply(const TriMesh& mesh, bool binary, int precision) {
     for (int k = 0; k < 3; ++k) {
       if (k) out += ' ';
       append_double(out, mesh.V(static_cast<Eigen::Index>(i), k), precision);
+    }
+    for (int k = 0; colors && k < 3; ++k) {
+      out += ' ';
+      append_int(out, channel(i, k));
     }
     out += '\n';
   }

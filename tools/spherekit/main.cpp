@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
   cli::register_convert(app);
   cli::register_consistent(app);
   cli::register_correspond(app);
+  cli::register_transfer(app);
+  cli::register_morph(app);
+  cli::register_pca(app);
 
   try {
     // The chosen subcommand's callback runs inside parse() and records its exit code.

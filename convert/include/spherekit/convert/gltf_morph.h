@@ -42,6 +42,11 @@ struct GltfMorphOptions {
   std::vector<std::string> names;
   std::string name = "collection";  ///< mesh and node name
   GltfProvenance provenance;        ///< asset.extras.spherekit (sphere_map: the collection)
+  /// > 0: adds an animation "morph" of this many seconds that shows the members in turn,
+  /// member k (target k-1 at weight 1) at time k * seconds / (members - 1), the weights
+  /// linearly interpolated in between (for members that are the frames of a morph sequence,
+  /// morph.h). 0: no animation. Needs >= 2 members.
+  double animation_seconds = 0;
   // DracoSequential only
   QuantizationBudget budget;        ///< quantization of the base (gltf_draco.h)
   double reference_rms_error = 0;   ///< error budget of the base's positions (<= 0: minimum bits)

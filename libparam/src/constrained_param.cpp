@@ -285,15 +285,28 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   const int nf = static_cast<int>(closed.F.rows());
   result.times.check = seconds_since(t_start);
 
+  // Normalize (centre, unit bounding-box diagonal) as the unconstrained stage does. The
+  // measures are taken on the normalized mesh too: stretch sums over the input's own
+  // coordinates overflow or underflow far from unit size, and the measures do not depend on
+  // scale.
+  const detail::Normalization nz = detail::bounding_box_normalization(closed.V);
+  const double diag = nz.diagonal;
+  if (!(diag > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
+  RowMat3d Pn = (closed.V.rowwise() - nz.centre) / diag;
+  TriMesh unit;
+  unit.V = Pn;
+  unit.F = closed.F;
+
   auto finish_measure = [&](const RowMat3d& S, const std::vector<int>& fv) -> Status {
     result.flipped_faces = count_flipped_faces(closed.F, S);
     std::vector<char> real(static_cast<size_t>(nf), 0);
     for (int f = 0; f < filled.original_faces; ++f) real[static_cast<size_t>(f)] = 1;
-    SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(closed, S, {}, &real));
+    SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(unit, S, {}, &real));
     result.efficiency = m.efficiency;
     result.l2_stretch = m.l2_stretch;
     result.linf_stretch = m.linf;
     result.winding = m.winding;
+    SPHEREKIT_RETURN_IF_ERROR(detail::require_finite_measures(m.efficiency, m.l2_stretch, m.linf));
     result.max_feature_angle = 0;
     for (int i = 0; i < k_given; ++i)
       result.max_feature_angle = std::max(
@@ -329,12 +342,16 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
       if (k_given == 1) S1.row(fv[0]) = targets[0].transpose();
       if (count_flipped_faces(mesh.F, S1) == 0) {
         result.flipped_faces = 0;
-        TriMesh open = mesh;
+        // The input's own faces (no hole faces) at the normalized positions.
+        TriMesh open;
+        open.V = Pn.topRows(filled.original_vertices);
+        open.F = mesh.F;
         SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(open, S1));
         result.efficiency = m.efficiency;
         result.l2_stretch = m.l2_stretch;
         result.linf_stretch = m.linf;
         result.winding = m.winding;
+        SPHEREKIT_RETURN_IF_ERROR(detail::require_finite_measures(m.efficiency, m.l2_stretch, m.linf));
         result.max_feature_angle = k_given ? angle_between(S1.row(fv[0]).transpose(), targets[0]) : 0.0;
         result.map.S = S1;
         result.map.provenance.library_version = kVersion;
@@ -373,13 +390,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   }
   const int k = static_cast<int>(fv.size());
 
-  // 3. Normalize (centre, unit bounding-box diagonal) as the unconstrained stage does.
-  const detail::Normalization nz = detail::bounding_box_normalization(closed.V);
-  const double diag = nz.diagonal;
-  if (!(diag > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
-  RowMat3d Pn = (closed.V.rowwise() - nz.centre) / diag;
-
-  // 4. Path network.
+  // 3.-4. Path network on the normalized mesh Pn (made above).
   auto t0 = std::chrono::steady_clock::now();
   detail::NetworkOptions no;
   no.steiner_penalty = options.steiner_penalty;

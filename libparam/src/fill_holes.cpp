@@ -8,6 +8,8 @@
 // overlaps itself in 3D. That is accepted on purpose: the fan only has to make the mesh a
 // closed genus-0 surface; parameterization works on connectivity and edge lengths, and
 // hole faces carry almost no weight there.
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -38,17 +40,30 @@ Status check_fillable(const MeshCheck& c) {
 }
 
 Eigen::RowVector3d loop_centre(const RowMat3d& V, const std::vector<int>& loop) {
+  // Computed on the loop scaled by a power of two that brings its largest coordinate near 1:
+  // |b - a|^2 and l * (a + b) overflow for coordinates beyond ~1e154 (and underflow for tiny
+  // ones), and scaling by 2^k is exact, so at ordinary scales the bits are those of the
+  // unscaled formula.
+  double largest = 0;
+  for (int v : loop) largest = std::max(largest, V.row(v).cwiseAbs().maxCoeff());
+  int exponent = 0;
+  (void)std::frexp(largest, &exponent);
+  // Coordinates into [-2, 2]; the clamp keeps both factors finite (2^1024 is not).
+  exponent = std::clamp(exponent - 1, -1000, 1000);
+  const double to_unit = std::ldexp(1.0, -exponent), back = std::ldexp(1.0, exponent);
   Eigen::RowVector3d weighted = Eigen::RowVector3d::Zero(), plain = Eigen::RowVector3d::Zero();
   double length = 0;
   for (size_t i = 0; i < loop.size(); ++i) {
-    const Eigen::RowVector3d a = V.row(loop[i]), b = V.row(loop[(i + 1) % loop.size()]);
+    const Eigen::RowVector3d a = V.row(loop[i]) * to_unit, b = V.row(loop[(i + 1) % loop.size()]) * to_unit;
     const double l = (b - a).norm();
     weighted += 0.5 * l * (a + b);
     length += l;
     plain += a;
   }
   // All loop vertices at one point (zero length): fall back to the plain average.
-  return length > 0 ? Eigen::RowVector3d(weighted / length) : Eigen::RowVector3d(plain / double(loop.size()));
+  const Eigen::RowVector3d centre = length > 0 ? Eigen::RowVector3d(weighted / length)
+                                               : Eigen::RowVector3d(plain / double(loop.size()));
+  return centre * back;
 }
 
 }  // namespace

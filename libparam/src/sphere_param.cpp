@@ -106,8 +106,14 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   // 6. Rotate to the best alignment with the surface normals. A rotation preserves every
   //    orientation in exact arithmetic, but rounding of the rotated coordinates could flip a
   //    tiny triangle, so the rotated map is kept only if the exact check still passes.
+  //    Both on the normalized mesh P: the face normals and stretch sums of the input's own
+  //    coordinates overflow or underflow far from unit size (NaN stretch at 1e100), and the
+  //    rotation and the measures (efficiency, normalized stretch) do not depend on scale.
+  TriMesh unit;
+  unit.V = P;
+  unit.F = closed.F;
   if (options.align_rotation) {
-    Eigen::Matrix3d R = alignment_rotation(closed, S, nf);
+    Eigen::Matrix3d R = alignment_rotation(unit, S, nf);
     RowMat3d rotated = S * R.transpose();
     rotated.rowwise().normalize();
     if (count_flipped_faces(closed.F, rotated) == 0) S = rotated;
@@ -118,11 +124,12 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   result.flipped_faces = count_flipped_faces(closed.F, S);
   std::vector<char> real(static_cast<size_t>(nf), 0);
   for (int f = 0; f < filled.original_faces; ++f) real[static_cast<size_t>(f)] = 1;
-  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(closed, S, {}, &real));
+  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(unit, S, {}, &real));
   result.efficiency = m.efficiency;
   result.l2_stretch = m.l2_stretch;
   result.linf_stretch = m.linf;
   result.winding = m.winding;
+  SPHEREKIT_RETURN_IF_ERROR(detail::require_finite_measures(m.efficiency, m.l2_stretch, m.linf));
 
   result.map.S = S.topRows(filled.original_vertices);
   result.map.provenance.library_version = kVersion;

@@ -99,8 +99,8 @@ bool cancel_requested() { return g_cancel != 0; }
 
 Status cancelled_status() { return Status(ErrorCode::Cancelled, "cancelled"); }
 
-ComputeScope::ComputeScope() { g_in_compute = 1; }
-ComputeScope::~ComputeScope() { g_in_compute = 0; }
+ComputeScope::ComputeScope() : previous_(g_in_compute) { g_in_compute = 1; }
+ComputeScope::~ComputeScope() { g_in_compute = previous_; }
 
 void set_child_pid(pid_t pid) { g_child_pid = static_cast<std::sig_atomic_t>(pid); }
 

@@ -70,12 +70,16 @@ void install_signal_handlers();
 bool cancel_requested();
 
 /// Marks a library computation that polls the progress callback (graceful cancellation).
+/// Scopes nest: leaving an inner one keeps the outer one in force.
 class ComputeScope {
  public:
   ComputeScope();
   ~ComputeScope();
   ComputeScope(const ComputeScope&) = delete;
   ComputeScope& operator=(const ComputeScope&) = delete;
+
+ private:
+  int previous_;
 };
 
 /// The child process `bench` is waiting for (0: none); a signal forwards SIGTERM to it.

@@ -348,6 +348,10 @@ int run_add(const AddArgs& a) {
   auto loaded = load_mesh_checked(a.mesh, /*allow_boundary=*/true, /*repair=*/false);
   if (!loaded.ok()) return print_error(loaded.status());
   const std::string name = a.name.empty() ? file_stem(a.mesh) : a.name;
+  // The map is written as DIR/<name>.sphere.obj: a name with a path would put it elsewhere
+  // (and make the manifest unreadable, see read_collection).
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
+    return print_error(Status(ErrorCode::InvalidArgument, "--name '" + name + "': must be a plain file name"));
   int existing = -1, i = 0;
   for (const Json& e : c.manifest["meshes"]) {
     if (e["name"].get<std::string>() == name) existing = i;
@@ -356,6 +360,8 @@ int run_add(const AddArgs& a) {
   if (existing >= 0 && !a.replace)
     return print_error(Status(ErrorCode::InvalidArgument, a.mesh + ": the collection already has a mesh named '" + name +
                                                               "' (use --name, or --replace to map it again)"));
+  // Never grow a broken collection: every other member's map must be there and fit.
+  if (Status s = check_member_maps(c, existing); !s.ok()) return print_error(s);
   const std::string lm = a.features.empty() ? default_features_path(a.mesh) : a.features;
   auto fv = features_in_order(lm, loaded->check.vertices, c.feature_names);
   if (!fv.ok()) return print_error(fv.status());
@@ -397,10 +403,21 @@ int run_add(const AddArgs& a) {
   // its map. If the manifest cannot be written, the new map is removed again.
   const std::string map_path = (fs::path(a.dir) / (name + ".sphere.obj")).string();
   const bool map_existed = fs::exists(map_path);
+  // --replace: the old map goes back if the manifest cannot be written, so that the folder
+  // stays as it was (the manifest still describes the old map).
+  std::string old_map;
+  if (map_existed) {
+    auto bytes = formats::read_file(map_path);
+    if (!bytes.ok()) return print_error(bytes.status());
+    old_map = std::move(bytes).value();
+  }
   if (Status s = formats::write_sphere_map(map_path, loaded->mesh, r.map); !s.ok()) return print_error(s);
   if (Status s = write_json_atomic((fs::path(a.dir) / kCollectionManifest).string(), man); !s.ok()) {
     std::error_code ec;
-    if (!map_existed) fs::remove(map_path, ec);
+    if (map_existed)
+      (void)formats::write_file_atomic(map_path, old_map);
+    else
+      fs::remove(map_path, ec);
     return print_error(s);
   }
   if (!a.quiet) {

@@ -43,7 +43,20 @@ Result<Mapped> load_member(const CollectionInfo& c, const std::string& path) {
     return Status(ErrorCode::InvalidInput, path + ": not a member of the collection " + c.dir +
                                                " (add it with 'spherekit add')");
   SPHEREKIT_ASSIGN_OR_RETURN(LoadedMesh m, load_mesh(path));
-  const std::string map_path = (fs::path(c.dir) / c.manifest["meshes"][static_cast<size_t>(i)]["map"].get<std::string>()).string();
+  const Json& e = c.manifest["meshes"][static_cast<size_t>(i)];
+  // The mesh must be the one that was mapped: say so when its vertex count shows it is not
+  // (the map reader below could only report that two counts differ).
+  if (e.contains("vertices") && e["vertices"].get<long long>() != static_cast<long long>(m.mesh.V.rows()))
+    return Status(ErrorCode::InvalidInput,
+                  strprintf("%s: has %lld vertices, but member '%s' of %s was mapped with %lld (not the mesh of "
+                            "the collection?)",
+                            path.c_str(), static_cast<long long>(m.mesh.V.rows()), e["name"].get<std::string>().c_str(),
+                            (fs::path(c.dir) / kCollectionManifest).string().c_str(), e["vertices"].get<long long>()));
+  const std::string map_path = (fs::path(c.dir) / e["map"].get<std::string>()).string();
+  std::error_code ec;
+  if (!fs::is_regular_file(map_path, ec))
+    return Status(ErrorCode::IoError, map_path + ": missing (the map of member '" + e["name"].get<std::string>() +
+                                          "' in " + (fs::path(c.dir) / kCollectionManifest).string() + ")");
   auto map = formats::read_sphere_map(map_path, m.mesh);
   if (!map.ok()) return map.status();
   Mapped out;

@@ -15,6 +15,7 @@
 namespace spherekit::cli {
 
 inline constexpr const char* kCollectionManifest = "collection.json";
+inline constexpr const char* kCollectionFeatures = "features.txt";
 inline constexpr const char* kCollectionFormat = "spherekit-collection";
 inline constexpr int kCollectionFormatVersion = 1;
 
@@ -27,9 +28,17 @@ struct CollectionInfo {
   std::vector<Eigen::Vector3d> locations;  ///< F, one per feature name
 };
 
-/// Reads and validates DIR/collection.json. Errors (naming the file): IoError, ParseError,
-/// InvalidInput (wrong format, missing or inconsistent fields, non-unit locations).
+/// Reads and validates DIR/collection.json, and DIR/features.txt against it. Errors (naming
+/// the file): IoError (missing), ParseError, InvalidInput (wrong format or version, missing,
+/// duplicate or inconsistent fields, non-unit locations, map names that are not plain file
+/// names, features.txt not holding exactly the manifest's features).
 Result<CollectionInfo> read_collection(const std::string& dir);
+
+/// Every member's map exists in the folder, is a readable OBJ and has the vertex count the
+/// manifest records (member `skip` excepted: the one `add --replace` maps again). Commands
+/// that grow a collection check this first, so that they never extend a broken one. Errors
+/// (naming the map): IoError (missing or unreadable), ParseError, InvalidInput (wrong count).
+Status check_member_maps(const CollectionInfo& c, int skip = -1);
 
 /// Index of the member whose map stem or source file matches `mesh_path` (its stem, or the
 /// same absolute path), or -1.
@@ -39,7 +48,9 @@ int find_member(const CollectionInfo& c, const std::string& mesh_path);
 /// staging folder beside it; the staging folder is renamed into place only once every file
 /// is written, replacing an existing collection folder (or an empty folder). On failure the
 /// staging folder is removed and `dir` is untouched. A non-empty folder that is not a
-/// collection is never replaced. Errors: IoError, or write_into's.
+/// collection is never replaced. SIGINT/SIGTERM during write_into only set the cancel flag
+/// (write_into may poll cancel_requested() between files); then the staging folder is removed
+/// and Cancelled returned. Errors: IoError, Cancelled, or write_into's.
 Status write_collection_folder(const std::string& dir, const std::function<Status(const std::string&)>& write_into);
 
 /// IoError unless `dir` can become a collection folder (absent, empty, or a collection), and

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "detail/sphere_state.h"
@@ -47,9 +49,30 @@ struct Normalization {
 inline Normalization bounding_box_normalization(const RowMat3d& V) {
   Normalization n;
   Eigen::RowVector3d lo = V.colwise().minCoeff(), hi = V.colwise().maxCoeff();
-  n.centre = 0.5 * (lo + hi);
-  n.diagonal = (hi - lo).norm();
+  // Halves first: lo + hi would overflow for coordinates beyond DBL_MAX / 2 (same bits
+  // otherwise, halving is exact).
+  n.centre = 0.5 * lo + 0.5 * hi;
+  const Eigen::RowVector3d extent = hi - lo;
+  n.diagonal = extent.norm();
+  // The squared length overflows for meshes beyond ~1e154 across (the diagonal became inf
+  // and every normalized position 0) and underflows below ~1e-154 (a mesh 1e-200 across
+  // looked like a point). There, divide by the longest side first; elsewhere norm() keeps
+  // the bits every existing map was made with.
+  if (!(n.diagonal > 1e-150 && n.diagonal < 1e150)) {
+    const double side = extent.cwiseAbs().maxCoeff();
+    if (side > 0 && side <= std::numeric_limits<double>::max()) n.diagonal = side * (extent / side).norm();
+  }
   return n;
+}
+
+/// SolverFailed unless a map's measures are finite: a result never reports a valid map with
+/// NaN or infinite stretch.
+inline Status require_finite_measures(double efficiency, double l2_stretch, double linf_stretch) {
+  if (std::isfinite(efficiency) && std::isfinite(l2_stretch) && std::isfinite(linf_stretch)) return Status();
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "the stretch of the map is not finite (efficiency %g, L2 %g, Linf %g)", efficiency,
+                l2_stretch, linf_stretch);
+  return Status(ErrorCode::SolverFailed, buf);
 }
 
 }  // namespace spherekit::detail

@@ -1,8 +1,6 @@
 // Members of a collection for the applications, and all-or-nothing outputs (member_io.h).
 #include "member_io.h"
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <system_error>
 
@@ -43,11 +41,6 @@ Result<Member> load_index(const CollectionInfo& c, int i, const std::string& fal
   return m;
 }
 
-bool holds_marker(const fs::path& dir, const std::string& marker) {
-  std::error_code ec;
-  return fs::is_regular_file(dir / marker, ec);
-}
-
 }  // namespace
 
 Result<Member> load_member(const CollectionInfo& c, const std::string& name_or_path) {
@@ -81,52 +74,18 @@ Status OutputFiles::write_all() const {
   return Status();
 }
 
+// Both delegate to the staged-folder writer the collection commands use (collection.h), so
+// every folder-writing command gets the same cancellation and signal-safe swap.
 Status require_output_folder(const std::string& dir, const std::string& marker) {
-  std::error_code ec;
-  const fs::path p(dir);
-  if (!fs::is_directory(fs::absolute(p, ec).parent_path(), ec))
-    return Status(ErrorCode::IoError, dir + ": parent folder does not exist");
-  if (!fs::exists(p, ec)) return Status();
-  if (!fs::is_directory(p, ec)) return Status(ErrorCode::IoError, dir + ": exists and is not a folder");
-  if (fs::is_empty(p, ec) || holds_marker(p, marker)) return Status();
-  return Status(ErrorCode::IoError, dir + ": folder is not empty and has no " + marker + "; refusing to replace it");
+  return require_staged_folder_target(dir, marker.c_str());
 }
 
 Status write_output_folder(const std::string& dir, const std::string& marker, const OutputFiles& files) {
-  SPHEREKIT_RETURN_IF_ERROR(require_output_folder(dir, marker));
-  std::error_code ec;
-  const fs::path target = fs::absolute(dir, ec).lexically_normal();
-  const fs::path base = target.has_filename() ? target : target.parent_path();
-  const fs::path staging = base.parent_path() / ("." + base.filename().string() + ".partial." + std::to_string(::getpid()));
-  fs::remove_all(staging, ec);
-  if (!fs::create_directory(staging, ec))
-    return Status(ErrorCode::IoError, staging.string() + ": cannot create staging folder (" + ec.message() + ")");
-  for (const auto& [name, bytes] : files.files()) {
-    Status s = formats::write_file_atomic((staging / name).string(), bytes);
-    if (!s.ok()) {
-      fs::remove_all(staging, ec);
-      return s;
-    }
-  }
-  const fs::path old = base.parent_path() / ("." + base.filename().string() + ".old." + std::to_string(::getpid()));
-  const bool had_old = fs::exists(base, ec);
-  if (had_old) {
-    fs::remove_all(old, ec);
-    fs::rename(base, old, ec);
-    if (ec) {
-      fs::remove_all(staging, ec);
-      return Status(ErrorCode::IoError, dir + ": cannot replace the existing folder (" + ec.message() + ")");
-    }
-  }
-  fs::rename(staging, base, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    if (had_old) fs::rename(old, base, ec);
-    fs::remove_all(staging, ec);
-    return Status(ErrorCode::IoError, dir + ": cannot move the output folder into place (" + why + ")");
-  }
-  if (had_old) fs::remove_all(old, ec);
-  return Status();
+  return write_staged_folder(dir, marker.c_str(), [&](const std::string& staging) -> Status {
+    for (const auto& [name, bytes] : files.files())
+      SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic((fs::path(staging) / name).string(), bytes));
+    return Status();
+  });
 }
 
 }  // namespace spherekit::cli

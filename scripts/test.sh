@@ -12,6 +12,9 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
 bash "$root/scripts/install_deps.sh"
 bash "$root/scripts/build.sh"
+# The results page's viewer and its browser test (npm packages, Debian's Chromium): optional,
+# that test skips with setup_viewer.sh's message when they cannot be installed.
+bash "$root/scripts/setup_viewer.sh" --browser --install-chromium >/dev/null || true
 
 log="$(mktemp)"
 trap 'rm -f "$log"' EXIT

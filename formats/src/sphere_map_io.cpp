@@ -114,6 +114,18 @@ Result<SphereMap> parse_sphere_map(const std::string& path, std::string_view byt
     return Status(ErrorCode::InvalidInput, path + ": has " + std::to_string(points.V.rows()) + " vertices, mesh has " +
                                                std::to_string(mesh.V.rows()));
   }
+  // A map lists the faces of the mesh it was made for. Same vertex count but other faces is a
+  // map of another mesh (a remesh, a different export of the same scan): using it would give
+  // a folded or meaningless result that passes every per-point check.
+  if (points.F.rows() > 0 && mesh.F.rows() > 0) {
+    if (points.F.rows() != mesh.F.rows())
+      return Status(ErrorCode::InvalidInput, path + ": has " + std::to_string(points.F.rows()) + " faces, mesh has " +
+                                                 std::to_string(mesh.F.rows()) + " (a map of another mesh)");
+    for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+      if (points.F.row(f) != mesh.F.row(f))
+        return Status(ErrorCode::InvalidInput, path + ": face " + std::to_string(f) +
+                                                   " differs from the mesh's (a map of another mesh)");
+  }
   SphereMap map;
   map.S = std::move(points.V);
   for (Eigen::Index i = 0; i < map.S.rows(); ++i) {

@@ -425,42 +425,5 @@ TEST_CASE("run maps given meshes and reports failures but keeps going", "[cli]")
   CHECK(report["summary"]["failed"] == 1);
 }
 
-TEST_CASE("run without meshes maps the built-in samples (the README's main job)", "[cli]") {
-  const std::string dir = spherekit::test::temp_dir("cli_run_samples");
-  const std::string out = dir + "/spherekit-out";
-  CliRun r = run_cli("run -o " + quote(out), dir);
-  INFO("stderr: " << r.err);
-  REQUIRE(r.exit_code == 0);
-  json report = parse_json(slurp(out + "/report.json"));
-  REQUIRE(report["meshes"].size() >= 2);
-  for (const json& m : report["meshes"]) {
-    INFO(m.dump());
-    CHECK(m["status"] == "ok");
-    CHECK(m["eval"]["flipped"] == 0);
-    CHECK(m["eval"]["flipped_exact"] == 0);
-    CHECK(fs::exists(m["sphere_map"].get<std::string>()));
-    // The main job also builds each map's 129 x 129 geometry image and its remesh PSNR.
-    REQUIRE(m.contains("geometry_image"));
-    const json& gim = m["geometry_image"];
-    CHECK(gim["size"] == 129);
-    const std::string gim_file = gim["file"].get<std::string>();
-    CHECK(fs::path(gim_file).filename().string() == m["name"].get<std::string>() + ".gim129.exr");
-    CHECK(fs::equivalent(fs::path(gim_file).parent_path(), fs::path(out)));
-    CHECK(fs::exists(gim_file));
-    REQUIRE(gim["psnr_db"].is_number());
-    const double psnr = gim["psnr_db"].get<double>();
-    CHECK(std::isfinite(psnr));
-    CHECK(psnr > 30);
-    CHECK(gim["seconds"].get<double>() >= 0);
-  }
-  CHECK(fs::is_directory(out + "/input"));
-  CHECK(r.out.find("PSNR129") != std::string::npos);
-  // ... and the consistent collection of the samples, measured against their ground truth.
-  CHECK(fs::exists(out + "/collection/collection.json"));
-  REQUIRE(report.contains("collection"));
-  const json& col = report["collection"];
-  INFO(col.dump());
-  CHECK(col["pairs"] == 12);
-  CHECK(col["mean_error"].get<double>() < 0.05);
-  CHECK(col["under_0.1"].get<double>() > 0.9);
-}
+// The main job on the built-in samples (run without meshes) is tested with its results page
+// in site_page_test.cpp.

@@ -1,11 +1,15 @@
 // Tests of the geometry-image EXR writer/reader (convert/src/geometry_image_exr.cpp).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <string>
 
 #include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/convert/geometry_image_png.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/version.h"
 #include "test_meshes.h"
@@ -67,4 +71,50 @@ TEST_CASE("geometry image EXR: errors", "[convert]") {
   REQUIRE_FALSE(missing.ok());
   CHECK(missing.status().code() == ErrorCode::IoError);
   CHECK(missing.status().message().find("missing.exr") != std::string::npos);
+}
+
+TEST_CASE("geometry image previews: normals and positions as colours, holes dimmed", "[convert]") {
+  const TriMesh blob = test::random_blob(3, 9);
+  auto r = sample_geometry_image(blob, blob.V.rowwise().normalized(), 17);
+  REQUIRE(r.ok());
+  GeometryImage gi = r.value();
+  auto normals = convert::geometry_image_preview(gi, convert::GeometryImagePreview::Normals);
+  REQUIRE(normals.ok());
+  REQUIRE(normals->width == 17);
+  REQUIRE(normals->height == 17);
+  REQUIRE(normals->channels == 3);
+  // Pixel (x, y) is texel (i = y, j = x): each channel is the normal mapped [-1, 1] -> [0, 255].
+  for (int i = 0; i < 17; i += 4)
+    for (int j = 0; j < 17; j += 3) {
+      const Eigen::Vector3f n = gi.normal(i, j);
+      for (int c = 0; c < 3; ++c) CHECK(std::abs(normals->at(j, i)[c] - 127.5 * (n[c] + 1)) <= 0.5 + 1e-3);
+    }
+  // Positions: the bounding box's largest extent spans 0..255 (up to rounding) on some channel.
+  auto pos = convert::geometry_image_preview(gi, convert::GeometryImagePreview::Positions);
+  REQUIRE(pos.ok());
+  int lo = 255, hi = 0;
+  for (std::size_t k = 0; k < pos->pixels.size(); ++k) {
+    lo = std::min<int>(lo, pos->pixels[k]);
+    hi = std::max<int>(hi, pos->pixels[k]);
+  }
+  CHECK(lo <= 1);
+  CHECK(hi >= 254);
+  // A texel marked as lying in a hole is drawn at half brightness.
+  gi.in_hole[5 * 17 + 7] = 1;
+  auto dimmed = convert::geometry_image_preview(gi, convert::GeometryImagePreview::Normals);
+  REQUIRE(dimmed.ok());
+  for (int c = 0; c < 3; ++c) CHECK(std::abs(2 * dimmed->at(7, 5)[c] - normals->at(7, 5)[c]) <= 2);
+  CHECK(dimmed->at(8, 5)[0] == normals->at(8, 5)[0]);
+  // Deterministic bytes, and malformed images are refused.
+  auto again = convert::geometry_image_preview(gi, convert::GeometryImagePreview::Normals);
+  REQUIRE(again.ok());
+  CHECK(again->pixels == dimmed->pixels);
+  GeometryImage bad = gi;
+  bad.normals.pop_back();
+  CHECK(convert::geometry_image_preview(bad, convert::GeometryImagePreview::Normals).status().code() ==
+        ErrorCode::InvalidArgument);
+  bad = gi;
+  bad.positions[4] = std::numeric_limits<float>::quiet_NaN();
+  CHECK(convert::geometry_image_preview(bad, convert::GeometryImagePreview::Positions).status().code() ==
+        ErrorCode::InvalidArgument);
 }

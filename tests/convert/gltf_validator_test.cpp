@@ -77,6 +77,24 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
   for (const char* name : {"cli_lod0.glb", "cli_lod1.glb", "cli_lod2.glb", "cli_lods.glb"}) files.push_back(dir + "/" + name);
+
+  // What a collection's commands write: `convert --collection` (levels, members as morph
+  // targets), `morph` (frames as targets, with an animation) and `pca` (components).
+  const std::string cap = test::temp_dir("gltf_validator_collection");
+  auto sk = [&](const std::string& args) {
+    const test::CliRun run = test::run_cli(SPHEREKIT_EXE, args, cap);
+    INFO("spherekit " << args << "\n" << run.err);
+    REQUIRE(run.exit_code == 0);
+  };
+  const std::string q = test::shell_quote(dir);
+  sk("samples -o " + q + "/in --members 2 --vertices 300");
+  sk("consistent -o " + q + "/col " + q + "/in/sample_a.obj " + q + "/in/sample_b.obj --no-refine --quiet");
+  sk("convert --collection " + q + "/col -o " + q + "/conv --gi 17 --lods 2 --psnr-samples 0 --quiet");
+  sk("morph " + q + "/col sample_a sample_b -o " + q + "/morph --frames 3 --size 17 --quiet");
+  sk("pca " + q + "/col -o " + q + "/pca --size 17 --quiet");
+  for (const char* name : {"conv/sample_a_lod0.glb", "conv/sample_b_lods.glb", "conv/collection_morph.glb",
+                           "morph/morph.glb", "pca/pca.glb"})
+    files.push_back(dir + "/" + name);
 #endif
 
   const nlohmann::json report = test::run_npm_validators(tools, files);
@@ -90,7 +108,9 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     // Every file but the uncompressed morph targets has Draco primitives, all decoded.
     const bool uncompressed = name.find("morph_plain") != std::string::npos ||
                               name.find("morph_trimesh") != std::string::npos ||
-                              name.find("morph_single") != std::string::npos;
+                              name.find("morph_single") != std::string::npos ||
+                              name.find("collection_morph") != std::string::npos ||
+                              name.find("morph.glb") != std::string::npos || name.find("pca.glb") != std::string::npos;
     CHECK((f.at("draco_primitives").get<int>() > 0) == !uncompressed);
   }
 }

@@ -120,6 +120,17 @@ TEST_CASE("sphere map: rejections", "[formats]") {
     CHECK(r.status().code() == ErrorCode::InvalidInput);
     CHECK(r.status().message() == path + ": has 42 vertices, mesh has 162");
   }
+  SECTION("same vertex count, other faces: a map of another mesh") {
+    const std::string path = dir + "/other.sphere.obj";
+    TriMesh flipped = mesh;
+    flipped.F.row(7) = mesh.F.row(7).reverse();  // same vertices, one face listed the other way round
+    REQUIRE(write_sphere_map(path, flipped, map).ok());
+    check_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "face 7 differs");
+    TriMesh fewer = mesh;
+    fewer.F.conservativeResize(mesh.F.rows() - 1, 3);
+    REQUIRE(write_sphere_map(path, fewer, map).ok());
+    check_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "79 faces, mesh has 80");
+  }
   SECTION("a zero point") {
     TriMesh bad = mesh;
     bad.V.row(5).setZero();

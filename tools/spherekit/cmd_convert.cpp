@@ -15,8 +15,10 @@
 #include "spherekit/convert/displacement.h"
 #include "spherekit/convert/displacement_exr.h"
 #include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/convert/geometry_image_png.h"
 #include "spherekit/convert/subd_cage.h"
 #include "spherekit/convert/gltf_lods.h"
+#include "spherekit/formats/atomic_file.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/geometry_image.h"
@@ -38,6 +40,20 @@ std::uintmax_t file_bytes(const std::string& path) {
 }
 
 Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+Result<std::vector<std::string>> write_geometry_image_previews(const GeometryImage& image, const std::string& prefix) {
+  std::vector<std::string> written;
+  const std::pair<convert::GeometryImagePreview, const char*> kinds[] = {
+      {convert::GeometryImagePreview::Normals, "_normals.png"}, {convert::GeometryImagePreview::Positions, "_positions.png"}};
+  for (const auto& [kind, suffix] : kinds) {
+    SPHEREKIT_ASSIGN_OR_RETURN(convert::Image8 preview, convert::geometry_image_preview(image, kind));
+    SPHEREKIT_ASSIGN_OR_RETURN(std::string png, convert::encode_png(preview));
+    const std::string path = prefix + suffix;
+    SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic(path, png));
+    written.push_back(path);
+  }
+  return written;
+}
 
 Status check_convert_flags(const ConvertArgs& a) {
   if (!is_geometry_image_size(a.size) || a.size > 16385)
@@ -181,6 +197,8 @@ int run_convert(const ConvertArgs& a) {
     return print_error(s);
   if (!a.remesh.empty())
     if (Status s = formats::write_mesh(a.remesh, remesh); !s.ok()) return print_error(s);
+  auto previews = write_geometry_image_previews(image, gltf_prefix(a.output));
+  if (!previews.ok()) return print_error(previews.status());
   const double write_seconds = write_time.seconds();
   if (cancel_requested()) return print_error(cancelled_status());
 
@@ -256,6 +274,7 @@ int run_convert(const ConvertArgs& a) {
     j["size"] = a.size;
     j["layout"] = "octahedral";
     j["texels_in_holes"] = image.texels_in_holes;
+    j["previews"] = previews.value();
     j["remesh_V"] = remesh.V.rows();
     j["remesh_F"] = remesh.F.rows();
     if (a.psnr_samples > 0) {
@@ -321,6 +340,7 @@ int run_convert(const ConvertArgs& a) {
                 static_cast<long long>(m.mesh.V.rows()), static_cast<long long>(m.mesh.F.rows()),
                 static_cast<long long>(remesh.V.rows()), static_cast<long long>(remesh.F.rows()),
                 image.texels_in_holes, image.texels_in_holes == 1 ? "" : "s");
+    std::printf("  previews %s, %s\n", previews->at(0).c_str(), previews->at(1).c_str());
     if (a.psnr_samples > 0) {
       std::printf("  PSNR %.2f dB (rms %.3g, max %.3g, bbox diagonal %.4g)\n", err.psnr, err.rms, err.max_distance,
                   err.peak);
@@ -371,7 +391,9 @@ void register_convert(CLI::App& app) {
       "octahedral geometry image (N = 2^k+1): each texel's sphere point is located in the sphere\n"
       "map and the surface position and normal are interpolated there. Writes a float EXR\n"
       "(R,G,B = position, N.X,N.Y,N.Z = normal, face_id; ZIP; provenance in the header), and\n"
-      "with --remesh the triangle mesh the image defines. Prints the remesh PSNR against the\n"
+      "with --remesh the triangle mesh the image defines, and two PNG previews of the image,\n"
+      "OUT_normals.png (normals as colours) and OUT_positions.png (positions in the bounding\n"
+      "box as colours; texels in holes of the mesh at half brightness). Prints the remesh PSNR against the\n"
       "original (peak = bounding-box diagonal, symmetric RMS surface distance); --report writes\n"
       "it with the timings as JSON. With --lods L it also writes L levels of detail (image sizes\n"
       "N, (N-1)/2+1, ...) as Draco-compressed glTF (POSITION, NORMAL, TEXCOORD_0 = texel centres\n"
@@ -389,7 +411,8 @@ void register_convert(CLI::App& app) {
       "one EXR atlas OUT_disp.exr (layout in its header; see README). It reports the PSNR of the\n"
       "bare limit surface and of the displaced one.\n"
       "With --collection DIR (instead of MESH SPHERE) every member of a consistent collection is\n"
-      "converted with the same options into the folder -o: NAME.exr, NAME_lod*.glb, NAME_cage.obj,\n"
+      "converted with the same options into the folder -o: NAME.exr, NAME_normals.png,\n"
+      "NAME_positions.png, NAME_lod*.glb, NAME_cage.obj,\n"
       "NAME_disp.exr per member, collection_morph.glb (one glTF, the members as morph targets),\n"
       "and convert_report.json (per member sizes and PSNRs, and per feature the texel that holds\n"
       "it in every image). All members share one layout: the same texel, cage vertex, glTF\n"

@@ -117,6 +117,17 @@ int run_morph(const MorphArgs& a) {
 
 }  // namespace
 
+int run_morph_job(const std::string& dir, const std::string& a, const std::string& b, const std::string& output,
+                  bool quiet) {
+  MorphArgs args;
+  args.dir = dir;
+  args.a = a;
+  args.b = b;
+  args.output = output;
+  args.quiet = quiet;
+  return run_morph(args);
+}
+
 void register_morph(CLI::App& app) {
   auto args = std::make_shared<MorphArgs>();
   CLI::App* cmd = add_command(

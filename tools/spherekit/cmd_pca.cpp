@@ -259,6 +259,14 @@ int run_pca(const PcaArgs& a) {
 
 }  // namespace
 
+int run_pca_job(const std::string& dir, const std::string& output, bool quiet) {
+  PcaArgs a;
+  a.dir = dir;
+  a.output = output;
+  a.quiet = quiet;
+  return run_pca(a);
+}
+
 void register_pca(CLI::App& app) {
   auto args = std::make_shared<PcaArgs>();
   CLI::App* cmd = add_command(

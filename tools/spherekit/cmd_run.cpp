@@ -1,8 +1,10 @@
 // `spherekit run`: the main job. Checks, parameterizes and evaluates every input mesh (the
 // built-in samples when none is given), writes the sphere maps and one report.json into an
 // output folder, builds each map's 129 x 129 octahedral geometry image (as `convert`) with its
-// remesh PSNR, and prints a summary table. A failing mesh is reported and skipped; the
-// others still run.
+// remesh PSNR, previews and glTF levels of detail, and prints a summary table. A failing mesh
+// is reported and skipped; the others still run. A collection (the samples, or meshes with
+// feature files) is then mapped consistently, converted and used by the applications
+// (run_collection.cpp), and everything is shown on OUT/index.html (site_page.h).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -15,8 +17,12 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "convert_common.h"
+#include "run_job.h"
+#include "site_page.h"
 #include "sample_collection.h"
 #include "spherekit/convert/geometry_image_exr.h"
+#include "spherekit/convert/gltf_lods.h"
 #include "spherekit/correspondence.h"
 #include "spherekit/formats/atomic_file.h"
 #include "spherekit/formats/sphere_map_io.h"
@@ -34,6 +40,8 @@ namespace {
 // the PSNR sample count per direction: lower than convert's default so the job stays fast.
 constexpr int kGeometryImageSize = 129;
 constexpr int kGeometryImagePsnrSamples = 100000;
+// glTF levels of detail per mesh from that image (129, 65, 33), for the page's 3-D view.
+constexpr int kGeometryImageLods = 3;
 
 Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
@@ -55,6 +63,7 @@ std::string unique_stem(const std::string& path, std::set<std::string>& used) {
 struct MeshOutcome {
   Json json;                       // the report entry
   std::vector<std::string> row;    // the summary-table row
+  Json model;                      // the results page's model (site_page.h), when made
   int exit_code = 0;
 };
 
@@ -126,12 +135,38 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
   RemeshErrorOptions psnr_opts;
   psnr_opts.samples = kGeometryImagePsnrSamples;
   const RemeshError err = remesh_error(m.mesh, remesh, psnr_opts, geometry_image_hole_faces(image));
+  // Previews and levels of detail (as `convert --lods`), for people and for the page.
+  const std::string gim_prefix = gltf_prefix(gim_path);
+  auto previews = write_geometry_image_previews(image, gim_prefix);
+  if (!previews.ok()) return fail(previews.status());
+  convert::GltfLodOptions lod_opts;
+  lod_opts.levels = kGeometryImageLods;
+  lod_opts.reference_rms_error = err.rms;
+  lod_opts.name = name;
+  lod_opts.provenance = {path, sphere_path};
+  auto lods = convert::build_gltf_lods(image, lod_opts);
+  if (!lods.ok()) return fail(lods.status());
+  auto lod_paths = convert::write_gltf_lods(gim_prefix, lods.value());
+  if (!lod_paths.ok()) return fail(lod_paths.status());
   const double gim_seconds = gim_time.seconds();
+  Json lod_files = Json::array(), page_lods = Json::array();
+  for (const std::string& f : lod_paths->levels) {
+    lod_files.push_back(f);
+    page_lods.push_back(fs::path(f).filename().string());
+  }
   out.json["geometry_image"] = Json{{"file", gim_path},
                                     {"size", kGeometryImageSize},
                                     {"psnr_db", number_or_null(err.psnr)},
                                     {"psnr_excludes_hole_faces", has_holes},
+                                    {"previews", previews.value()},
+                                    {"lods", lod_files},
                                     {"seconds", gim_seconds}};
+  out.model = Json{{"name", name},
+                   {"lods", page_lods},
+                   {"images", Json::array({Json{{"label", "geometry image: normals"},
+                                                {"png", fs::path(previews->at(0)).filename().string()}},
+                                           Json{{"label", "geometry image: positions"},
+                                                {"png", fs::path(previews->at(1)).filename().string()}}})}};
 
   out.json["status"] = "ok";
   out.json["times"] = Json{{"read", m.read_seconds},        {"check", m.check_seconds},
@@ -229,7 +264,12 @@ int run_main_job(const RunArgs& a) {
   report["options"] = sphere_param_options_json(a.options);
   report["meshes"] = Json::array();
 
-  Table table({"mesh", "V", "F", "holes", "efficiency", "Linf", "flips", "winding", "PSNR129", "time s", "status"});
+  const std::vector<std::string> columns = {"mesh",    "V",      "F",       "holes",  "efficiency", "Linf",
+                                            "flips",   "winding", "PSNR129", "time s", "status"};
+  Table table(columns);
+  Json site;
+  site["title"] = "SphereKit results";
+  Json map_rows = Json::array();
   std::set<std::string> used;
   int worst = 0, failed = 0;
   for (const std::string& path : inputs) {
@@ -238,39 +278,87 @@ int run_main_job(const RunArgs& a) {
     if (one.exit_code != 0) ++failed;
     worst = worse_exit_code(worst, one.exit_code);
     report["meshes"].push_back(std::move(one.json));
+    if (!one.model.is_null()) site["models"].push_back(std::move(one.model));
+    map_rows.push_back(one.row);
     table.add_row(std::move(one.row));
   }
-  if (use_samples && failed == 0) {
-    // The samples share landmarks: map them consistently too (as `consistent`), and measure
-    // the correspondence the collection induces against their exact ground truth.
-    std::printf("\nConsistent collection of the samples (as 'spherekit consistent'):\n");
+  site["tables"].push_back({{"label", "Sphere maps (as 'spherekit param'; efficiency = L2 stretch efficiency, PSNR of "
+                                      "the 129 x 129 geometry image in dB)"},
+                            {"columns", columns},
+                            {"rows", map_rows}});
+
+  // The consistent collection: the samples always (they share landmarks); user meshes when
+  // there are at least two and each has its feature file beside it (NAME.lm.txt).
+  bool collection = use_samples;
+  if (!use_samples && inputs.size() >= 2) {
+    collection = true;
+    for (const std::string& path : inputs) {
+      std::error_code ec;
+      const fs::path lm = fs::path(path).parent_path() / (fs::path(path).stem().string() + ".lm.txt");
+      if (!fs::is_regular_file(lm, ec)) collection = false;
+    }
+  }
+  bool collection_done = false;
+  if (collection && failed == 0) {
+    std::printf("\nConsistent collection of the %s (as 'spherekit consistent'):\n",
+                use_samples ? "samples" : "meshes");
     const std::string col_dir = (out_dir / "collection").string();
     const int code = run_consistent_job(inputs, col_dir, (out_dir / "collection_report.json").string(), a.quiet,
                                         a.options);
     worst = worse_exit_code(worst, code);
-    if (code == 0) {
+    if (code == 0 && use_samples) {
+      // The samples have exact ground truth: measure the correspondence the collection induces.
       Json col = collection_correspondence_json(inputs, col_dir);
       report["collection"] = col;
       std::printf("correspondence vs. ground truth over %d ordered pairs: mean error %.4f, %.1f%% under 0.05, %.1f%% "
                   "under 0.1 (geodesic / sqrt(area))\n",
                   col["pairs"].get<int>(), col["mean_error"].get<double>(), 100 * col["under_0.05"].get<double>(),
                   100 * col["under_0.1"].get<double>());
+      site["tables"].push_back({{"label", "Correspondence the consistent maps induce, against the samples' exact "
+                                          "ground truth (geodesic error / sqrt(area))"},
+                                {"columns", {"ordered pairs", "mean error", "under 0.05", "under 0.1"}},
+                                {"rows", {{col["pairs"], col["mean_error"], col["under_0.05"], col["under_0.1"]}}}});
+    }
+    if (code == 0) {
+      if (cancel_requested()) return print_error(cancelled_status());
+      Json models_before = site["models"];
+      const int stages = run_collection_stages(col_dir, out_dir.string(), a.quiet, site, report);
+      worst = worse_exit_code(worst, stages);
+      collection_done = stages == 0;
+      if (stages != 0) site["models"] = models_before;
     }
   }
+  site["description"] =
+      std::string(use_samples ? "The built-in sample collection" : "The given meshes") +
+      ", each mapped bijectively onto the sphere (Praun and Hoppe 2003)" +
+      (collection_done ? " and all of them consistently onto one sphere (Asirvatham, Praun and Hoppe 2005). Every "
+                         "asset below shares one layout: the same geometry-image texel, glTF vertex and cage vertex is "
+                         "the same place on every member; that is what the morphs, the transfers and the PCA use."
+                       : ". Each model is its 129 x 129 octahedral geometry image as Draco glTF levels of detail.") +
+      " Files and numbers: report.json in this folder.";
   report["summary"] = Json{{"meshes", inputs.size()},
                            {"ok", static_cast<int>(inputs.size()) - failed},
                            {"failed", failed},
+                           {"collection", collection_done},
                            {"wall_seconds", wall.seconds()},
                            {"cpu_seconds", cpu_seconds()},
                            {"peak_rss_mb", peak_rss_mb()}};
+
+  std::vector<std::string> warnings;
+  if (Status s = write_site_page(out_dir.string(), site, &warnings); !s.ok()) return print_error(s);
+  for (const std::string& w : warnings) std::fprintf(stderr, "spherekit: warning: %s\n", w.c_str());
+  report["page"] = (out_dir / "index.html").string();
 
   const std::string report_path = (out_dir / "report.json").string();
   if (Status s = write_json_atomic(report_path, report); !s.ok()) return print_error(s);
 
   std::printf("\n");
   table.print();
-  std::printf("\n%d of %zu meshes mapped; sphere maps, geometry images and report.json in:\n%s\n",
-              static_cast<int>(inputs.size()) - failed, inputs.size(), out_dir.c_str());
+  std::printf("\n%d of %zu meshes mapped in %.1f s; sphere maps, geometry images, %sreport.json in:\n%s\n"
+              "results page: %s\n",
+              static_cast<int>(inputs.size()) - failed, inputs.size(), wall.seconds(),
+              collection_done ? "the collection's assets and applications, " : "", out_dir.c_str(),
+              (out_dir / "index.html").c_str());
   return worst;
 }
 
@@ -283,13 +371,20 @@ void register_run(CLI::App& app) {
       "The main job. For each MESH (default: the built-in sample collection, written first to\n"
       "OUT/input): check it, map it bijectively onto the sphere (as `param`), write\n"
       "OUT/<name>.sphere.obj, measure the map (as `eval`), build its 129 x 129 octahedral\n"
-      "geometry image OUT/<name>.gim129.exr with the remesh PSNR (as `convert --size 129`,\n"
-      "100000 PSNR samples per direction), and finally write OUT/report.json (per-mesh check,\n"
-      "measures, geometry image and times) and print a summary table and the folder. A mesh that\n"
-      "fails is reported and skipped; the exit code is then that of the worst failure.\n"
-      "On the built-in samples it also maps them consistently (as `consistent`) into\n"
-      "OUT/collection and measures that correspondence against the samples' ground truth\n"
-      "(report.json `collection`: mean geodesic error / sqrt(area), fractions under 0.05, 0.1).",
+      "geometry image OUT/<name>.gim129.exr with the remesh PSNR (100000 samples per direction),\n"
+      "PNG previews and 3 Draco glTF levels of detail (as `convert --size 129 --lods 3`).\n"
+      "Then, for the samples, or for two or more meshes that each have a feature file beside\n"
+      "them (NAME.lm.txt, as `consistent` reads them): map them consistently into\n"
+      "OUT/collection (as `consistent`); convert every member into OUT/assets (as `convert\n"
+      "--collection`: images, previews, LODs, Catmull-Clark cage 8 with 9 x 9 scalar\n"
+      "displacement, the morph-target glTF); and run the applications into OUT/apps (colours\n"
+      "and normals transferred from the first member, a morph of the first two, PCA with the\n"
+      "compression experiment). For the samples it also measures the correspondence against\n"
+      "their ground truth. Finally it writes OUT/report.json and OUT/index.html, a results page\n"
+      "(3-D viewer of the glTF files with levels of detail and morph sliders, the images, plots\n"
+      "and tables) that works opened from disk or served; its 3-D viewer needs three.js from npm\n"
+      "(scripts/setup_viewer.sh; without it the page says so and shows the rest).\n"
+      "A mesh that fails is reported and skipped; the exit code is then that of the worst failure.\n",
       "  spherekit run                              # built-in samples -> ./spherekit-out\n"
       "  spherekit run spot.obj bunny.obj -o maps   # your meshes -> ./maps\n"
       "  spherekit run ../shared/meshes/*.obj --effort 3");

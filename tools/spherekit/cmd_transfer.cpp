@@ -197,6 +197,20 @@ int run_transfer(const TransferArgs& a) {
 
 }  // namespace
 
+int run_transfer_job(const std::string& dir, const std::string& from, const std::string& to, const std::string& what,
+                     const std::string& output, const std::string& attributes, const std::string& report, bool quiet) {
+  TransferArgs a;
+  a.dir = dir;
+  a.from = from;
+  a.to = to;
+  a.what = what;
+  a.output = output;
+  a.attributes = attributes;
+  a.report = report;
+  a.quiet = quiet;
+  return run_transfer(a);
+}
+
 void register_transfer(CLI::App& app) {
   auto args = std::make_shared<TransferArgs>();
   CLI::App* cmd = add_command(

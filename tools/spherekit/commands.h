@@ -35,4 +35,13 @@ void register_pca(CLI::App& app);         // cmd_pca.cpp:      mean shape, compo
 int run_consistent_job(const std::vector<std::string>& meshes, const std::string& output, const std::string& report,
                        bool quiet, const SphereParamOptions& sphere);
 
+/// The applications with their default options, for `run` (exit codes as the commands):
+/// `transfer DIR --from FROM --to TO --what WHAT -o OUTPUT [--attributes A] [--report R]`,
+/// `morph DIR A B -o OUTPUT`, `pca DIR -o OUTPUT`. Empty `attributes`/`report`: not given.
+int run_transfer_job(const std::string& dir, const std::string& from, const std::string& to, const std::string& what,
+                     const std::string& output, const std::string& attributes, const std::string& report, bool quiet);
+int run_morph_job(const std::string& dir, const std::string& a, const std::string& b, const std::string& output,
+                  bool quiet);
+int run_pca_job(const std::string& dir, const std::string& output, bool quiet);
+
 }  // namespace spherekit::cli

@@ -86,6 +86,13 @@ int run_convert_collection(const ConvertArgs& a) {
                                                                   {m.source, (fs::path(info->dir) / (m.name + ".sphere.obj")).string()}));
       j["image"] = {{"file", exr}, {"bytes", file_bytes((fs::path(dir) / exr).string())},
                     {"texels_in_holes", out.image.texels_in_holes}};
+      {
+        auto previews = write_geometry_image_previews(out.image, (fs::path(dir) / m.name).string());
+        if (!previews.ok()) return previews.status();
+        Json names = Json::array();
+        for (const std::string& p : previews.value()) names.push_back(fs::path(p).filename().string());
+        j["image"]["previews"] = std::move(names);
+      }
       if (a.psnr_samples > 0) {
         RemeshErrorOptions opts;
         opts.samples = a.psnr_samples;

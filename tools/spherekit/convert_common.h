@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cli_common.h"
 #include "spherekit/convert/gltf_draco.h"
@@ -37,6 +38,9 @@ Status check_convert_flags(const ConvertArgs& a);
 std::string gltf_prefix(const std::string& output);
 std::uintmax_t file_bytes(const std::string& path);
 Json number_or_null(double x);
+/// PNG previews of a geometry image (convert/geometry_image_png.h), written atomically:
+/// PREFIX_normals.png and PREFIX_positions.png. Returns the paths written.
+Result<std::vector<std::string>> write_geometry_image_previews(const GeometryImage& image, const std::string& prefix);
 
 /// What --cage produced, for the report and the summary.
 struct CageOutput {

@@ -13,8 +13,9 @@ namespace spherekit::formats {
 /// Writes S with the faces of `mesh` atomically; a comment header records provenance.
 Status write_sphere_map(const std::string& path, const TriMesh& mesh, const SphereMap& map);
 
-/// Reads a sphere map for `mesh`: InvalidInput if the vertex count differs from the mesh's
-/// or a point is not finite / is zero; points are returned normalised.
+/// Reads a sphere map for `mesh`: InvalidInput if the vertex count differs from the mesh's,
+/// if its faces differ from the mesh's (when both have faces: a map of another mesh), or a
+/// point is not finite / is zero; points are returned normalised.
 Result<SphereMap> read_sphere_map(const std::string& path, const TriMesh& mesh);
 
 }  // namespace spherekit::formats

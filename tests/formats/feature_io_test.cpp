@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 using namespace spherekit;
 using namespace spherekit::formats;
 
-std::string write_file(const std::string& dir, const std::string& name, const std::string& text) {
+std::string write_feature_file(const std::string& dir, const std::string& name, const std::string& text) {
   const std::string path = dir + "/" + name;
   std::error_code ec;
   fs::remove(path, ec);  // replace, not truncate (see mesh_io_test.cpp)
@@ -54,20 +54,20 @@ TEST_CASE("landmarks: round trip, comments and blank lines", "[formats]") {
     CHECK((*back)[i].vertex == marks[i].vertex);
   }
 
-  const std::string hand = write_file(dir, "hand.lm.txt", "# header\n\n  nose 3   # the tip\r\n\tchin +4\n   \n");
+  const std::string hand = write_feature_file(dir, "hand.lm.txt", "# header\n\n  nose 3   # the tip\r\n\tchin +4\n   \n");
   Result<std::vector<Landmark>> h = read_landmarks(hand);
   REQUIRE(h.ok());
   REQUIRE(h->size() == 2);
   CHECK((*h)[0].name == "nose");
   CHECK((*h)[1].vertex == 4);
-  CHECK(read_landmarks(write_file(dir, "none.lm.txt", "# nothing\n"))->empty());
+  CHECK(read_landmarks(write_feature_file(dir, "none.lm.txt", "# nothing\n"))->empty());
 }
 
 TEST_CASE("landmarks: rejected lines name file and line", "[formats]") {
   const std::string dir = test::temp_dir("formats_landmarks_errors");
   const std::string head = "# landmarks\na 1\n";  // the bad line is line 3
   auto read = [&](const std::string& bad, int num_vertices = 10) {
-    return read_landmarks(write_file(dir, "f.lm.txt", head + bad + "\n"), num_vertices);
+    return read_landmarks(write_feature_file(dir, "f.lm.txt", head + bad + "\n"), num_vertices);
   };
   const std::string path = dir + "/f.lm.txt";
   check_error(read("b"), ErrorCode::ParseError, path, 3, "got 1 fields");
@@ -134,7 +134,7 @@ TEST_CASE("sphere points: exact round trip and normalisation", "[formats]") {
     }
   }
 
-  const std::string loose = write_file(dir, "loose.txt", "# comment\na 2 0 0\n\nb 0 3 4 # five\n");
+  const std::string loose = write_feature_file(dir, "loose.txt", "# comment\na 2 0 0\n\nb 0 3 4 # five\n");
   Result<std::vector<SpherePoint>> n = read_sphere_points(loose);
   REQUIRE(n.ok());
   CHECK((*n)[0].p == Eigen::Vector3d(1, 0, 0));
@@ -148,7 +148,7 @@ TEST_CASE("sphere points: huge and subnormal points become unit vectors", "[form
   // precision in |p|. Both must come back as unit vectors pointing the same way.
   const std::string dir = test::temp_dir("formats_sphere_points_range");
   const std::string path =
-      write_file(dir, "range.txt", "big 1e303 0 999999\nhuge 1.7e308 -1.7e308 1.7e308\ntiny 1e-320 1e-320 0\n");
+      write_feature_file(dir, "range.txt", "big 1e303 0 999999\nhuge 1.7e308 -1.7e308 1.7e308\ntiny 1e-320 1e-320 0\n");
   for (bool require_unit : {false, true}) {
     Result<std::vector<SpherePoint>> r = read_sphere_points(path, require_unit);
     if (require_unit) {
@@ -169,7 +169,7 @@ TEST_CASE("sphere points: huge and subnormal points become unit vectors", "[form
 
 TEST_CASE("landmark targets: unit vectors, ranges and duplicates", "[formats]") {
   const std::string dir = test::temp_dir("formats_landmark_targets");
-  const std::string good = write_file(dir, "t.txt", "# name vertex x y z\nnose 3 0 0 1\ntail 0 0.577 0.577 0.577\n");
+  const std::string good = write_feature_file(dir, "t.txt", "# name vertex x y z\nnose 3 0 0 1\ntail 0 0.577 0.577 0.577\n");
   Result<std::vector<formats::LandmarkTarget>> r = read_landmark_targets(good, 4);
   REQUIRE(r.ok());
   REQUIRE(r->size() == 2);
@@ -180,7 +180,7 @@ TEST_CASE("landmark targets: unit vectors, ranges and duplicates", "[formats]") 
 
   const std::string path = dir + "/b.txt";
   auto read = [&](const std::string& bad, int num_vertices = 4) {
-    return read_landmark_targets(write_file(dir, "b.txt", "a 0 1 0 0\n" + bad + "\n"), num_vertices);
+    return read_landmark_targets(write_feature_file(dir, "b.txt", "a 0 1 0 0\n" + bad + "\n"), num_vertices);
   };
   check_error(read("b 1 0 1"), ErrorCode::ParseError, path, 2, "got 4 fields");
   check_error(read("b one 0 1 0"), ErrorCode::ParseError, path, 2, "is not an integer");
@@ -201,7 +201,7 @@ TEST_CASE("sphere points: rejected lines name file and line", "[formats]") {
   const std::string dir = test::temp_dir("formats_sphere_points_errors");
   const std::string path = dir + "/s.txt";
   auto read = [&](const std::string& bad) {
-    return read_sphere_points(write_file(dir, "s.txt", "a 1 0 0\n" + bad + "\n"));
+    return read_sphere_points(write_feature_file(dir, "s.txt", "a 1 0 0\n" + bad + "\n"));
   };
   check_error(read("b 0 1"), ErrorCode::ParseError, path, 2, "got 3 fields");
   check_error(read("b 0 1 0 0"), ErrorCode::ParseError, path, 2, "got 5 fields");

@@ -23,7 +23,7 @@ std::string put(const std::string& dir, const std::string& name, const std::stri
   return path;
 }
 
-AttributedMesh read_ok(const std::string& path) {
+AttributedMesh read_attributed_ok(const std::string& path) {
   auto r = read_mesh_with_attributes(path);
   INFO(r.status().message());
   REQUIRE(r.ok());
@@ -45,7 +45,7 @@ const char* kSquareObj =
 
 TEST_CASE("OBJ colours, texture coordinates and materials are read", "[formats][attributes]") {
   const std::string dir = spherekit::test::temp_dir("attr_obj_read");
-  const AttributedMesh m = read_ok(put(dir, "sq.obj", kSquareObj));
+  const AttributedMesh m = read_attributed_ok(put(dir, "sq.obj", kSquareObj));
   REQUIRE(m.mesh.V.rows() == 4);
   REQUIRE(m.attributes.colors.rows() == 4);
   CHECK(m.attributes.colors.row(3) == Eigen::RowVector3d(0.5, 0.25, 1));
@@ -67,7 +67,7 @@ TEST_CASE("OBJ colours, texture coordinates and materials are read", "[formats][
 TEST_CASE("OBJ texture indices follow the fan triangulation of polygons", "[formats][attributes]") {
   const std::string dir = spherekit::test::temp_dir("attr_obj_quad");
   // One quad; texture indices deliberately differ from the vertex indices, and a relative one.
-  const AttributedMesh m = read_ok(put(dir, "q.obj",
+  const AttributedMesh m = read_attributed_ok(put(dir, "q.obj",
                                        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                                        "vt 0.1 0.1\nvt 0.9 0.1\nvt 0.9 0.9\nvt 0.1 0.9\nvt 0.5 0.5\n"
                                        "f 1/5 2/1 3/2 4/-2\n"));
@@ -80,7 +80,7 @@ TEST_CASE("OBJ texture indices follow the fan triangulation of polygons", "[form
 
 TEST_CASE("OBJ without texture indices on every corner has UV but no FT", "[formats][attributes]") {
   const std::string dir = spherekit::test::temp_dir("attr_obj_partial");
-  const AttributedMesh m = read_ok(put(dir, "p.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\n"
+  const AttributedMesh m = read_attributed_ok(put(dir, "p.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\n"
                                                      "f 1/1 2/1 3/1\nf 1 3 4\n"));
   CHECK(m.attributes.UV.rows() == 1);
   CHECK(m.attributes.FT.rows() == 0);
@@ -93,13 +93,13 @@ TEST_CASE("PLY red green blue are read as fractions of their type", "[formats][a
                                "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
                                "property uchar alpha\nelement face 1\nproperty list uchar int vertex_indices\n"
                                "end_header\n0 0 0 255 0 51 9\n1 0 0 0 255 0 9\n0 1 0 102 102 102 9\n3 0 1 2\n");
-  const AttributedMesh m = read_ok(path);
+  const AttributedMesh m = read_attributed_ok(path);
   REQUIRE(m.attributes.colors.rows() == 3);
   CHECK(m.attributes.colors(0, 0) == 1.0);
   CHECK(m.attributes.colors(0, 2) == Approx(0.2));
   CHECK(m.attributes.colors(2, 1) == Approx(0.4));
   // A PLY with only some of the channels has no colours.
-  const AttributedMesh g = read_ok(put(dir, "g.ply",
+  const AttributedMesh g = read_attributed_ok(put(dir, "g.ply",
                                        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                                        "property float z\nproperty uchar red\nelement face 1\n"
                                        "property list uchar int vertex_indices\nend_header\n"
@@ -119,7 +119,7 @@ TEST_CASE("attributes survive a write/read round trip (OBJ exactly, PLY to 8 bit
   a.material_libraries = {"ball.mtl"};
   a.material = "ball";
   REQUIRE(write_mesh_with_attributes(dir + "/ball.obj", mesh, a).ok());
-  const AttributedMesh back = read_ok(dir + "/ball.obj");
+  const AttributedMesh back = read_attributed_ok(dir + "/ball.obj");
   CHECK(back.mesh.V == mesh.V);
   CHECK(back.mesh.F == mesh.F);
   CHECK(back.attributes.colors == a.colors);
@@ -134,7 +134,7 @@ TEST_CASE("attributes survive a write/read round trip (OBJ exactly, PLY to 8 bit
     WriteOptions o;
     o.binary = binary;
     REQUIRE(write_mesh_with_attributes(dir + "/ball.ply", mesh, colors_only, o).ok());
-    const AttributedMesh p = read_ok(dir + "/ball.ply");
+    const AttributedMesh p = read_attributed_ok(dir + "/ball.ply");
     REQUIRE(p.attributes.colors.rows() == mesh.V.rows());
     // uchar channels: rounding to the nearest of 256 levels moves a value by at most 1/510.
     CHECK((p.attributes.colors - a.colors).cwiseAbs().maxCoeff() <= 0.5 / 255 + 1e-12);

@@ -28,7 +28,7 @@ SphereMap radial_map(const TriMesh& mesh) {
   return map;
 }
 
-void check_error(const Status& s, ErrorCode code, const std::string& path, const std::string& word) {
+void check_map_error(const Status& s, ErrorCode code, const std::string& path, const std::string& word) {
   INFO("message: " << s.message());
   REQUIRE_FALSE(s.ok());
   CHECK(s.code() == code);
@@ -125,18 +125,18 @@ TEST_CASE("sphere map: rejections", "[formats]") {
     TriMesh flipped = mesh;
     flipped.F.row(7) = mesh.F.row(7).reverse();  // same vertices, one face listed the other way round
     REQUIRE(write_sphere_map(path, flipped, map).ok());
-    check_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "face 7 differs");
+    check_map_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "face 7 differs");
     TriMesh fewer = mesh;
     fewer.F.conservativeResize(mesh.F.rows() - 1, 3);
     REQUIRE(write_sphere_map(path, fewer, map).ok());
-    check_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "79 faces, mesh has 80");
+    check_map_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "79 faces, mesh has 80");
   }
   SECTION("a zero point") {
     TriMesh bad = mesh;
     bad.V.row(5).setZero();
     const std::string path = dir + "/zero.obj";
     REQUIRE(write_mesh(path, bad).ok());
-    check_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "point 5 is zero");
+    check_map_error(read_sphere_map(path, mesh).status(), ErrorCode::InvalidInput, path, "point 5 is zero");
   }
   SECTION("a non-finite point") {
     const std::string path = dir + "/nan.obj";
@@ -144,7 +144,7 @@ TEST_CASE("sphere map: rejections", "[formats]") {
     REQUIRE(write_file_atomic(path, text).ok());
     TriMesh three;
     three.V = RowMat3d::Zero(3, 3);
-    check_error(read_sphere_map(path, three).status(), ErrorCode::InvalidInput, path, "non-finite");
+    check_map_error(read_sphere_map(path, three).status(), ErrorCode::InvalidInput, path, "non-finite");
   }
   SECTION("a newer format version, a bad seed") {
     const std::string path = dir + "/future.obj";
@@ -153,24 +153,24 @@ TEST_CASE("sphere map: rejections", "[formats]") {
     std::string future = text;
     future.replace(0, future.find('\n'), "# spherekit sphere map v" + std::to_string(kFormatVersion + 1));
     REQUIRE(write_file_atomic(path, future).ok());
-    check_error(read_sphere_map(path, mesh).status(), ErrorCode::Unsupported, path, "newer");
+    check_map_error(read_sphere_map(path, mesh).status(), ErrorCode::Unsupported, path, "newer");
     std::string seed = text;
     seed.replace(seed.find("# seed "), 7, "# seed x");
     REQUIRE(write_file_atomic(path, seed).ok());
-    check_error(read_sphere_map(path, mesh).status(), ErrorCode::ParseError, path + ":5:", "bad seed");
+    check_map_error(read_sphere_map(path, mesh).status(), ErrorCode::ParseError, path + ":5:", "bad seed");
   }
   SECTION("writer preconditions") {
     SphereMap short_map = map;
     short_map.S.conservativeResize(10, 3);
-    check_error(write_sphere_map(dir + "/s.obj", mesh, short_map), ErrorCode::InvalidInput, dir + "/s.obj",
+    check_map_error(write_sphere_map(dir + "/s.obj", mesh, short_map), ErrorCode::InvalidInput, dir + "/s.obj",
                 "10 points");
-    check_error(write_sphere_map(dir + "/s.ply", mesh, map), ErrorCode::Unsupported, dir + "/s.ply", ".obj");
-    check_error(write_sphere_map(dir + "/none/s.obj", mesh, map), ErrorCode::IoError, dir + "/none/s.obj",
+    check_map_error(write_sphere_map(dir + "/s.ply", mesh, map), ErrorCode::Unsupported, dir + "/s.ply", ".obj");
+    check_map_error(write_sphere_map(dir + "/none/s.obj", mesh, map), ErrorCode::IoError, dir + "/none/s.obj",
                 "does not exist");
     CHECK_FALSE(fs::exists(dir + "/s.obj"));
   }
   SECTION("missing file") {
-    check_error(read_sphere_map(dir + "/absent.obj", mesh).status(), ErrorCode::IoError, dir + "/absent.obj",
+    check_map_error(read_sphere_map(dir + "/absent.obj", mesh).status(), ErrorCode::IoError, dir + "/absent.obj",
                 "cannot open");
   }
 }

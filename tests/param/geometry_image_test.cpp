@@ -61,7 +61,7 @@ EdgeCount count_edges(const TriMesh& m) {
   return c;
 }
 
-double signed_volume(const TriMesh& m) {
+double remesh_signed_volume(const TriMesh& m) {
   double v = 0;
   for (int f = 0; f < m.F.rows(); ++f)
     v += Vector3d(m.V.row(m.F(f, 0))).dot(Vector3d(m.V.row(m.F(f, 1))).cross(Vector3d(m.V.row(m.F(f, 2)))));
@@ -294,7 +294,7 @@ TEST_CASE("the remesh of a geometry image is a closed, consistently oriented gen
     const auto V = static_cast<long>(rm.V.rows()), E = static_cast<long>(e.undirected.size()),
                F = static_cast<long>(rm.F.rows());
     CHECK(V - E + F == 2);
-    CHECK(signed_volume(rm) > 0);  // outward
+    CHECK(remesh_signed_volume(rm) > 0);  // outward
     // Octahedron edges are mesh edges.
     const int h = (n - 1) / 2;
     if (n >= 5) {

@@ -37,7 +37,7 @@ struct Mapped {
   SphereMap map;
 };
 
-Result<Mapped> load_member(const CollectionInfo& c, const std::string& path) {
+Result<Mapped> load_mapped_member(const CollectionInfo& c, const std::string& path) {
   const int i = find_member(c, path);
   if (i < 0)
     return Status(ErrorCode::InvalidInput, path + ": not a member of the collection " + c.dir +
@@ -115,9 +115,9 @@ int run_correspond(const CorrespondArgs& a) {
   if (Status s = require_output_folders({a.output}); !s.ok()) return print_error(s);
   auto col = read_collection(a.dir);
   if (!col.ok()) return print_error(col.status());
-  auto A = load_member(col.value(), a.a);
+  auto A = load_mapped_member(col.value(), a.a);
   if (!A.ok()) return print_error(A.status());
-  auto B = load_member(col.value(), a.b);
+  auto B = load_mapped_member(col.value(), a.b);
   if (!B.ok()) return print_error(B.status());
   const TriMesh& ma = A->mesh.mesh;
   const TriMesh& mb = B->mesh.mesh;

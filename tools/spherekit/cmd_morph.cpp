@@ -33,7 +33,7 @@ struct MorphArgs {
 };
 
 /// OBJ text of a mesh (17 significant digits: the frames read back bit for bit).
-std::string obj_text(const TriMesh& mesh) {
+std::string frame_obj_text(const TriMesh& mesh) {
   auto bytes = formats::format_mesh_with_attributes("frame.obj", mesh, {});
   return bytes.ok() ? std::move(bytes).value() : std::string();
 }
@@ -81,7 +81,7 @@ int run_morph(const MorphArgs& a) {
   Json frames = Json::array();
   for (std::size_t k = 0; k < seq->frames.size(); ++k) {
     const std::string name = strprintf("frame_%03zu.obj", k);
-    files.add(name, obj_text(seq->frames[k]));
+    files.add(name, frame_obj_text(seq->frames[k]));
     frames.push_back({{"file", name}, {"t", seq->times[k]}});
   }
   const convert::Similarity& H = seq->alignment;

@@ -12,6 +12,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "convert_common.h"  // number_or_null
 #include "member_io.h"
 #include "spherekit/convert/consistent_remesh.h"
 #include "spherekit/convert/gltf_morph.h"
@@ -34,11 +35,9 @@ struct PcaArgs {
   bool quiet = false;
 };
 
-/// JSON has no infinity: an exact reconstruction's PSNR is written as null.
-Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 std::string csv_number(double x) { return std::isfinite(x) ? strprintf("%.9g", x) : std::string("inf"); }
 
-Result<std::string> obj_text(const TriMesh& mesh) { return formats::format_mesh_with_attributes("m.obj", mesh, {}); }
+Result<std::string> mesh_obj_text(const TriMesh& mesh) { return formats::format_mesh_with_attributes("m.obj", mesh, {}); }
 
 Result<std::string> png_of(const convert::LinePlot& plot) {
   SPHEREKIT_ASSIGN_OR_RETURN(convert::Image8 image, convert::render_line_plot(plot));
@@ -99,7 +98,7 @@ int run_pca(const PcaArgs& a) {
 
   OutputFiles files;
   auto add_mesh = [&](const std::string& name, const TriMesh& m) -> Status {
-    SPHEREKIT_ASSIGN_OR_RETURN(std::string text, obj_text(m));
+    SPHEREKIT_ASSIGN_OR_RETURN(std::string text, mesh_obj_text(m));
     files.add(name, std::move(text));
     return Status();
   };

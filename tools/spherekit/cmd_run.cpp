@@ -43,7 +43,6 @@ constexpr int kGeometryImagePsnrSamples = 100000;
 // glTF levels of detail per mesh from that image (129, 65, 33), for the page's 3-D view.
 constexpr int kGeometryImageLods = 3;
 
-Json number_or_null(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
 
 struct RunArgs {
   std::vector<std::string> meshes;

@@ -14,6 +14,8 @@
 // mesh network and the arc network stay isomorphic as embedded graphs, edge by edge.
 #include "detail/path_network.h"
 
+#include "detail/split_undo.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -491,6 +493,14 @@ class Builder {
     return true;
   }
 
+  // Rolls the mesh back to when `mark` splits existed (a discarded trial's Steiner vertices
+  // go with it, see detail/split_undo.h); `net` must not use any of them.
+  void undo_splits_to(NetState& net, size_t mark) {
+    undo_splits({&X_, &F_, &vf_, &face_origin_, &steiner_parent_, &splits_}, mark);
+    feat_of_.resize(X_.size());
+    net.on_path.resize(X_.size(), -1);
+  }
+
   void remove_path(NetState& net, int id) {
     NetworkPath& p = net.paths[static_cast<size_t>(id)];
     for (size_t i = 1; i + 1 < p.verts.size(); ++i) net.on_path[static_cast<size_t>(p.verts[i])] = -1;
@@ -721,7 +731,11 @@ class Builder {
           continue;
         }
       }
-      if (!embed(net_, i, j, nodes, len, D(i, j))) continue;
+      const size_t mark = splits_.size();
+      if (!embed(net_, i, j, nodes, len, D(i, j))) {
+        undo_splits_to(net_, mark);
+        continue;
+      }
       if (uf.unite(i, j)) {
         --components;
         if (components == 1) {
@@ -790,6 +804,7 @@ class Builder {
       const int fa = net_.paths[static_cast<size_t>(best)].a, fb = net_.paths[static_cast<size_t>(best)].b;
       tried.insert(edge_key(fa, fb));
       NetState trial = net_;
+      const size_t mark = splits_.size();
       std::vector<int> ids;
       for (int f : {fa, fb})
         for (int q : trial.at[static_cast<size_t>(f)])
@@ -806,7 +821,7 @@ class Builder {
       std::vector<std::array<int, 2>> order;
       for (const auto& a : arcs) order.push_back(a.second);
       if (!reinsert(trial, order)) {
-        net_.on_path.resize(X_.size(), -1);
+        undo_splits_to(net_, mark);
         continue;
       }
       double after = 0;
@@ -815,8 +830,9 @@ class Builder {
       if (after < before * 0.9) {
         net_ = std::move(trial);
         ++swirls_fixed_;
+      } else {
+        undo_splits_to(net_, mark);
       }
-      net_.on_path.resize(X_.size(), -1);  // Steiner vertices of a discarded trial stay free
       if (!report_progress(progress_, "network", net_.alive, -1.0))
         return Status(ErrorCode::Cancelled, "cancelled while building the path network");
     }
@@ -869,8 +885,9 @@ class Builder {
         double len;
         if (!trace(trial, c, d, &nodes, &len)) continue;
         if (!(len < p.length * 0.999)) continue;
+        const size_t mark = splits_.size();
         if (!embed(trial, c, d, nodes, len, D(c, d))) {
-          net_.on_path.resize(X_.size(), -1);
+          undo_splits_to(net_, mark);
           continue;
         }
         net_ = std::move(trial);

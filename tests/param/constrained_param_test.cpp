@@ -373,3 +373,82 @@ TEST_CASE("a twisted thin finger gets a bijective map without swirling paths", "
   // The twist costs some stretch on the finger, not the map's quality.
   CHECK(r->efficiency > 0.5 * u->efficiency);
 }
+
+namespace {
+
+// k features by farthest-point sampling (Euclidean) from vertex 0.
+std::vector<int> farthest_point_features(const TriMesh& m, int k) {
+  std::vector<int> fv{0};
+  std::vector<double> d(static_cast<size_t>(m.V.rows()), 1e300);
+  while (static_cast<int>(fv.size()) < k) {
+    int best = -1;
+    for (int v = 0; v < m.V.rows(); ++v) {
+      d[static_cast<size_t>(v)] = std::min(d[static_cast<size_t>(v)], (m.V.row(v) - m.V.row(fv.back())).norm());
+      if (best < 0 || d[static_cast<size_t>(v)] > d[static_cast<size_t>(best)]) best = v;
+    }
+    fv.push_back(best);
+  }
+  return fv;
+}
+
+}  // namespace
+
+TEST_CASE("a dense feature set (64 features) gets a bijective map through the feature triangulation",
+          "[param][constrained][dense]") {
+  // Dense features with targets moved 10 to 16 degrees make the network builder try and
+  // discard repairs whose Steiner splits land on the edges of paths it restores; the mesh
+  // must be rolled back with the network, else a path steps along an edge the mesh no longer
+  // has and the constrained simplification gets stuck above the feature triangulation.
+  TriMesh m = test::random_blob(4, 3);
+  const int k = 64;
+  std::vector<int> fv = farthest_point_features(m, k);
+  SphereParamOptions uo;
+  uo.threads = 1;
+  auto u = parameterize_sphere(m, uo);
+  REQUIRE(u.ok());
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> uni(0, 1);
+  std::vector<Eigen::Vector3d> t;
+  for (int v : fv) {
+    Eigen::Vector3d p = u->map.S.row(v).transpose().normalized();
+    Eigen::Vector3d a = Eigen::AngleAxisd(2 * M_PI * uni(rng), p) * p.unitOrthogonal();
+    const double angle = (10.0 + 6.0 * uni(rng)) * M_PI / 180.0;
+    t.push_back((Eigen::AngleAxisd(angle, a) * p).normalized());
+  }
+
+  SECTION("every path edge is an edge of the network mesh") {
+    RowMat3d V = m.V;
+    auto r = detail::build_path_network(V, m.F, fv, t, {}, {});
+    REQUIRE(r.ok());
+    const auto& net = r.value();
+    REQUIRE(static_cast<int>(net.paths.size()) == 3 * k - 6);
+    REQUIRE(net.steiner_parent.size() + m.V.rows() == net.X.size());
+    std::vector<std::vector<int>> vf(net.X.size());
+    for (size_t f = 0; f < net.F.size(); ++f)
+      for (int v : net.F[f]) vf[static_cast<size_t>(v)].push_back(static_cast<int>(f));
+    auto adjacent = [&](int a, int b) {
+      for (int f : vf[static_cast<size_t>(a)]) {
+        const auto& c = net.F[static_cast<size_t>(f)];
+        if (c[0] == b || c[1] == b || c[2] == b) return true;
+      }
+      return false;
+    };
+    int broken = 0;
+    for (const auto& p : net.paths)
+      for (size_t i = 1; i < p.verts.size(); ++i)
+        if (!adjacent(p.verts[i - 1], p.verts[i])) ++broken;
+    CHECK(broken == 0);
+    // Every vertex is used by a face (no Steiner vertex left over from a discarded trial).
+    for (size_t v = 0; v < net.X.size(); ++v) REQUIRE(!vf[v].empty());
+  }
+  SECTION("map") {
+    ConstrainedParamOptions o;
+    o.sphere.threads = 1;
+    auto r = parameterize_sphere_constrained(m, fv, t, o);
+    REQUIRE(r.ok());
+    require_valid_map(m, r->map.S);
+    require_on_targets(r->map.S, fv, t);
+    CHECK(r->max_feature_angle < 1e-9);
+    CHECK(r->network.paths == 3 * k - 6);
+  }
+}

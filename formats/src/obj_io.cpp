@@ -4,6 +4,7 @@
 // corners' texture indices, `mtllib` and the first `usemtl` are kept too.
 // Face corners may be `i`, `i/t`, `i/t/n` or `i//n`; negative indices count back from the
 // last vertex (texture coordinate) defined so far (OBJ's relative indices).
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,9 @@ Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const 
         int n = 0;
         while (n < 4 && next_token(rest, token) && token.front() != '#' && parse_double(token, extra[n])) ++n;
         if (n == 3) {
+          // A colour of inf or nan (or an overflowing 1e400) is not a colour (fuzz finding).
+          if (!std::isfinite(extra[0]) || !std::isfinite(extra[1]) || !std::isfinite(extra[2]))
+            return Status(ErrorCode::ParseError, at_line(path, lines.number()) + "vertex colour is not finite");
           colors.resize(3 * static_cast<std::size_t>(builder.num_vertices()), 0.0);
           colors.insert(colors.end(), extra, extra + 3);
           ++colored_vertices;
@@ -77,6 +81,8 @@ Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const 
         }
         if (!parse_double(token, st[k]))
           return Status(ErrorCode::ParseError, at_line(path, lines.number()) + "bad number " + quote_token(token));
+        if (!std::isfinite(st[k]))
+          return Status(ErrorCode::ParseError, at_line(path, lines.number()) + "texture coordinate is not finite");
       }
       uv.insert(uv.end(), st, st + 2);
     } else if (attributes && token == "mtllib") {
@@ -128,9 +134,12 @@ Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const 
       return Status(ErrorCode::ParseError, path + ": " + std::to_string(colored_vertices) + " of " +
                                                std::to_string(mesh.V.rows()) + " vertices have colours (all or none)");
     if (colored_vertices > 0) attributes->colors = Eigen::Map<const RowMat3d>(colors.data(), mesh.V.rows(), 3);
+    // Texture coordinates come with the corners that use them, or not at all: coordinates no
+    // face refers to cannot be written back (an OBJ `vt` is only reachable from an `f`), so a
+    // round trip would silently lose them (found by the attributes fuzz harness).
     const auto nt = static_cast<Eigen::Index>(uv.size() / 2);
-    attributes->UV = Eigen::Map<const RowMat2d>(uv.data(), nt, 2);
     if (!corner_without_uv && nt > 0 && static_cast<Eigen::Index>(tex_corners.size()) == 3 * mesh.F.rows()) {
+      attributes->UV = Eigen::Map<const RowMat2d>(uv.data(), nt, 2);
       for (const std::int64_t t : tex_corners) {
         if (t < 0 || t >= nt)
           return Status(ErrorCode::ParseError, path + ": texture index " + std::to_string(t + 1) + " out of range (" +

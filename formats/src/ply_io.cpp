@@ -7,6 +7,7 @@
 // Hostile files: the header's element counts are never trusted for allocation (reserves
 // are clamped by the bytes actually left), every binary read is bounds-checked, and every
 // loop iteration consumes input or fails, so garbage cannot make the reader hang.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -431,8 +432,13 @@ Result<TriMesh> read_ply(const std::string& path, std::string_view bytes, const 
     }
   }
   SPHEREKIT_ASSIGN_OR_RETURN(TriMesh mesh, builder.finish(info));
-  if (want_colors && static_cast<Eigen::Index>(colors.size()) == 3 * mesh.V.rows())
+  if (want_colors && static_cast<Eigen::Index>(colors.size()) == 3 * mesh.V.rows()) {
+    // Float colour channels can hold inf or nan: not a colour (fuzz finding, as for OBJ).
+    for (std::size_t i = 0; i < colors.size(); ++i)
+      if (!std::isfinite(colors[i]))
+        return Status(ErrorCode::ParseError, path + ": vertex " + std::to_string(i / 3) + " has a non-finite colour");
     attributes->colors = Eigen::Map<const RowMat3d>(colors.data(), mesh.V.rows(), 3);
+  }
   return mesh;
 }
 

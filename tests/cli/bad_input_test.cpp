@@ -354,6 +354,7 @@ TEST_CASE("bad input: sphere maps", "[cli]") {
       {"sphere_map_flipped.sphere.obj", "(8 of 8 faces flipped or degenerate on the sphere); nothing written", false,
        ""},
       {"sphere_map_future_version.sphere.obj", ":1: sphere map format v99 is newer", false, ""},
+      {"sphere_map_other_faces.sphere.obj", "face 2 differs from the mesh's (a map of another mesh)", false, ""},
   };
   for (const Case& c : kCases) {
     INFO("case: " << c.file);

@@ -78,12 +78,18 @@ TEST_CASE("OBJ texture indices follow the fan triangulation of polygons", "[form
   CHECK(m.attributes.colors.rows() == 0);
 }
 
-TEST_CASE("OBJ without texture indices on every corner has UV but no FT", "[formats][attributes]") {
+TEST_CASE("OBJ without texture indices on every corner has neither UV nor FT", "[formats][attributes]") {
+  // Found by the attributes fuzz harness: UV kept without FT were dropped by the writer (a
+  // `vt` is reachable only from an `f`), so a round trip changed the attributes.
   const std::string dir = spherekit::test::temp_dir("attr_obj_partial");
   const AttributedMesh m = read_attributed_ok(put(dir, "p.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\n"
                                                      "f 1/1 2/1 3/1\nf 1 3 4\n"));
-  CHECK(m.attributes.UV.rows() == 1);
+  CHECK(m.attributes.UV.rows() == 0);
   CHECK(m.attributes.FT.rows() == 0);
+  REQUIRE(write_mesh_with_attributes(dir + "/back.obj", m.mesh, m.attributes).ok());
+  const AttributedMesh back = read_attributed_ok(dir + "/back.obj");
+  CHECK(back.attributes.UV.rows() == 0);
+  CHECK(back.mesh.F == m.mesh.F);
 }
 
 TEST_CASE("PLY red green blue are read as fractions of their type", "[formats][attributes]") {
@@ -160,6 +166,14 @@ TEST_CASE("malformed attributes are refused with the file and line", "[formats][
   fails("empty_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt\nf 1 2 3\n", "no value");
   fails("vt_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/7\n", "out of range");
   fails("vt_zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/0 2/1 3/1\n", "texture index");
+  // Fuzz findings: colours and texture coordinates of inf, nan or an overflowing number.
+  fails("inf_color.obj", "v 0 0 0 11e308 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nf 1 2 3\n", ":1: vertex colour is not finite");
+  fails("nan_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt nan 0\nf 1/1 2/1 3/1\n", ":4: texture coordinate is not finite");
+  fails("inf_color.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "property float red\nproperty float green\nproperty float blue\nelement face 1\n"
+        "property list uchar int vertex_indices\nend_header\n0 0 0 1 0 0\n1 0 0 0 inf 0\n0 1 0 0 0 1\n3 0 1 2\n",
+        "vertex 1 has a non-finite colour");
   // Attribute shapes are checked before writing.
   MeshAttributes wrong;
   wrong.colors = RowMat3d::Zero(2, 3);

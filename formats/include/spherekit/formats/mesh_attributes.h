@@ -30,8 +30,9 @@ using RowMat2d = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
 struct MeshAttributes {
   RowMat3d colors;  ///< #V by 3 RGB (0..1 by convention), or empty
   RowMat2d UV;      ///< #T by 2 texture coordinates (OBJ convention), or empty
-  /// #F by 3 indices into UV, one per face corner (triangulated like F), or empty. Set only
-  /// when every face corner of the file has a texture coordinate.
+  /// #F by 3 indices into UV, one per face corner (triangulated like F), or empty. The reader
+  /// sets UV and FT together, only when every face corner of the file has a texture
+  /// coordinate (else both stay empty).
   RowMat3i FT;
   RowMat3d normals;  ///< #V by 3 per-vertex normals (written as OBJ `vn`, index = vertex), or empty
   std::vector<std::string> material_libraries;  ///< OBJ `mtllib` file names, as written

@@ -31,36 +31,7 @@ if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
   exit 3
 fi
 
-installed_version() {  # installed_version NAME -> version or nothing
-  local pj="$dir/node_modules/$1/package.json"
-  [[ -f "$pj" ]] && node -p "require(process.argv[1]).version" "$pj" 2>/dev/null || true
-}
-
-missing() {
-  local spec name version out=()
-  for spec in "${packages[@]}"; do
-    name="${spec%@*}"; version="${spec##*@}"
-    [[ "$(installed_version "$name")" == "$version" ]] || out+=("$spec")
-  done
-  echo "${out[@]:-}"
-}
-
-mkdir -p "$dir"
-exec 9>"$dir/.lock"
-flock 9
-todo="$(missing)"
-if [[ -n "$todo" ]]; then
-  echo "setup_npm_tools: installing $todo into $dir" >&2
-  [[ -f "$dir/package.json" ]] || echo '{ "name": "spherekit-npm-tools", "version": "0.0.0", "private": true }' >"$dir/package.json"
-  # shellcheck disable=SC2086  # $todo is a list of package specs
-  if ! (cd "$dir" && npm install --no-audit --no-fund --loglevel=error $todo >&2); then
-    echo "setup_npm_tools: npm install failed (is the npm registry reachable?)" >&2
-    exit 3
-  fi
-  todo="$(missing)"
-  if [[ -n "$todo" ]]; then
-    echo "setup_npm_tools: still missing after npm install: $todo" >&2
-    exit 3
-  fi
-fi
+# shellcheck source=npm_pinned.sh
+source "$(dirname "${BASH_SOURCE[0]}")/npm_pinned.sh"
+npm_pinned_install setup_npm_tools spherekit-npm-tools "$dir" "${packages[@]}"
 echo "$dir"

@@ -59,42 +59,13 @@ if [[ "$browser" == 1 && ! -x "$chromium" ]]; then
   fi
 fi
 
-installed_version() {  # installed_version NAME -> version or nothing
-  local pj="$dir/node_modules/$1/package.json"
-  [[ -f "$pj" ]] && node -p "require(process.argv[1]).version" "$pj" 2>/dev/null || true
-}
-
-missing() {
-  local spec name version out=()
-  for spec in "${packages[@]}"; do
-    name="${spec%@*}"; version="${spec##*@}"
-    [[ "$(installed_version "$name")" == "$version" ]] || out+=("$spec")
-  done
-  echo "${out[@]:-}"
-}
-
-mkdir -p "$dir"
-exec 9>"$dir/.lock"
-flock 9
-todo="$(missing)"
-if [[ -n "$todo" ]]; then
-  echo "setup_viewer: installing $todo into $dir" >&2
-  [[ -f "$dir/package.json" ]] || echo '{ "name": "spherekit-viewer", "version": "0.0.0", "private": true }' >"$dir/package.json"
-  # shellcheck disable=SC2086  # $todo is a list of package specs
-  if ! (cd "$dir" && npm install --no-audit --no-fund --loglevel=error $todo >&2); then
-    echo "setup_viewer: npm install failed (is the npm registry reachable?)" >&2
-    exit 3
-  fi
-  todo="$(missing)"
-  if [[ -n "$todo" ]]; then
-    echo "setup_viewer: still missing after npm install: $todo" >&2
-    exit 3
-  fi
-fi
+# shellcheck source=npm_pinned.sh
+source "$(dirname "${BASH_SOURCE[0]}")/npm_pinned.sh"
+npm_pinned_install setup_viewer spherekit-viewer "$dir" "${packages[@]}"
 
 # The bundle: rebuilt when absent or made from other versions. Built beside dist/ and renamed
 # into place, so a results folder never copies a half-written viewer.
-stamp="three $three_version, esbuild $(installed_version esbuild), bundle v1"
+stamp="three $three_version, esbuild $(npm_installed_version "$dir" esbuild), bundle v1"
 if [[ ! -f "$dir/dist/STAMP" || "$(cat "$dir/dist/STAMP")" != "$stamp" ]]; then
   echo "setup_viewer: bundling three.js $three_version into $dir/dist" >&2
   tmp="$dir/dist.tmp"

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_runner.h"
+#include "cli_shorthands.h"
 #include "spherekit/formats/mesh_attributes.h"
 #include "spherekit/formats/mesh_io.h"
 #include "test_paths.h"
@@ -18,20 +19,12 @@
 namespace fs = std::filesystem;
 using nlohmann::json;
 using spherekit::test::CliRun;
+using spherekit::test::q;
+using spherekit::test::read_json;
+using spherekit::test::sk;
 using spherekit::test::slurp;
 
 namespace {
-
-CliRun sk(const std::string& args, const std::string& capture_dir) {
-  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
-}
-std::string q(const std::string& s) { return spherekit::test::shell_quote(s); }
-
-json read_json(const std::string& path) {
-  json j = json::parse(slurp(path), nullptr, false);
-  REQUIRE_FALSE(j.is_discarded());
-  return j;
-}
 
 bool is_png(const std::string& path) { return slurp(path).rfind("\x89PNG\r\n\x1a\n", 0) == 0; }
 

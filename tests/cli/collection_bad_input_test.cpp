@@ -21,29 +21,22 @@
 #include <vector>
 
 #include "cli_runner.h"
+#include "cli_shorthands.h"
 #include "test_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using spherekit::test::CliRun;
+using spherekit::test::q;
+using spherekit::test::read_json;
+using spherekit::test::sk;
 using spherekit::test::slurp;
 
 namespace {
 
-CliRun sk(const std::string& args, const std::string& capture_dir) {
-  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
-}
-std::string q(const std::string& s) { return spherekit::test::shell_quote(s); }
-
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out << text;
-}
-
-json read_json(const std::string& path) {
-  json j = json::parse(slurp(path), nullptr, /*allow_exceptions=*/false);
-  REQUIRE_FALSE(j.is_discarded());
-  return j;
 }
 
 // Every file of a folder (names, including hidden temporary files) with its bytes.

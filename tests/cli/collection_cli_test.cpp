@@ -15,19 +15,18 @@
 #include <Eigen/Geometry>
 
 #include "cli_runner.h"
+#include "cli_shorthands.h"
 #include "test_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using spherekit::test::CliRun;
+using spherekit::test::q;
+using spherekit::test::read_json;
+using spherekit::test::sk;
 using spherekit::test::slurp;
 
 namespace {
-
-CliRun sk(const std::string& args, const std::string& capture_dir) {
-  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
-}
-std::string q(const std::string& s) { return spherekit::test::shell_quote(s); }
 
 // `v x y z` lines of an OBJ.
 std::vector<Eigen::Vector3d> obj_points(const std::string& path) {
@@ -72,12 +71,6 @@ void require_features_on_locations(const std::string& samples, const std::string
     const Eigen::Vector3d s = S.at(static_cast<size_t>(v[0]));
     CHECK(std::atan2(s.cross(loc).norm(), s.dot(loc)) < 1e-12);
   }
-}
-
-json read_json(const std::string& path) {
-  json j = json::parse(slurp(path), nullptr, false);
-  REQUIRE_FALSE(j.is_discarded());
-  return j;
 }
 
 }  // namespace

@@ -13,19 +13,18 @@
 #include <vector>
 
 #include "cli_runner.h"
+#include "cli_shorthands.h"
 #include "test_paths.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 using spherekit::test::CliRun;
+using spherekit::test::q;
+using spherekit::test::read_json;
+using spherekit::test::sk;
 using spherekit::test::slurp;
 
 namespace {
-
-CliRun sk(const std::string& args, const std::string& capture_dir) {
-  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
-}
-std::string q(const std::string& s) { return spherekit::test::shell_quote(s); }
 
 // The smallest useful built-in collection: two members of ~600 vertices, sample_b with a
 // hole (hole filling and its weights take part). Small keeps the test near 10 s in Release.
@@ -48,13 +47,6 @@ void erase_run_measures(json& j) {
   } else if (j.is_array()) {
     for (json& e : j) erase_run_measures(e);
   }
-}
-
-json read_json(const std::string& path) {
-  json j = json::parse(slurp(path), nullptr, /*allow_exceptions=*/false);
-  INFO("file: " << path);
-  REQUIRE_FALSE(j.is_discarded());
-  return j;
 }
 
 // A report with the run measures removed; `threads` (when >= 0) must be the recorded thread

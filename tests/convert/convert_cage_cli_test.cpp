@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cli_runner.h"
+#include "cli_shorthands.h"
 #include "spherekit/convert/displacement_exr.h"
 #include "spherekit/convert/geometry_image_exr.h"
 #include "spherekit/formats/mesh_io.h"
@@ -24,20 +25,12 @@ namespace fs = std::filesystem;
 using namespace spherekit;
 using nlohmann::json;
 using spherekit::test::CliRun;
+using spherekit::test::q;
+using spherekit::test::read_json;
+using spherekit::test::sk;
 using spherekit::test::slurp;
 
 namespace {
-
-CliRun sk(const std::string& args, const std::string& capture_dir) {
-  return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
-}
-std::string q(const std::string& s) { return spherekit::test::shell_quote(s); }
-
-json read_json(const std::string& path) {
-  json j = json::parse(slurp(path), nullptr, false);
-  REQUIRE_FALSE(j.is_discarded());
-  return j;
-}
 
 // The "f" lines of an OBJ (the cage's topology).
 std::vector<std::string> face_lines(const std::string& path) {

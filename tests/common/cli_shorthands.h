@@ -1,0 +1,31 @@
+// Shorthands of the end-to-end tests that run this build's `spherekit` (SPHEREKIT_EXE, defined
+// per test target): run it, quote a shell word, read a JSON file a command wrote.
+#pragma once
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cli_runner.h"
+
+namespace spherekit::test {
+
+#ifdef SPHEREKIT_EXE
+/// `spherekit ARGS`, output captured into `capture_dir` (see run_cli).
+inline CliRun sk(const std::string& args, const std::string& capture_dir) {
+  return run_cli(SPHEREKIT_EXE, args, capture_dir);
+}
+#endif
+
+/// `s` as one shell word.
+inline std::string q(const std::string& s) { return shell_quote(s); }
+
+/// The JSON document in `path`; fails the test (REQUIRE) when it does not parse.
+inline nlohmann::json read_json(const std::string& path) {
+  nlohmann::json j = nlohmann::json::parse(slurp(path), nullptr, /*allow_exceptions=*/false);
+  INFO("file: " << path);
+  REQUIRE_FALSE(j.is_discarded());
+  return j;
+}
+
+}  // namespace spherekit::test

@@ -142,6 +142,7 @@ Result<GeometryImage> sample_geometry_image(const TriMesh& mesh, const RowMat3d&
     }
   }
   image.texels_in_holes = in_holes;
+  if (options.fit_positions) SPHEREKIT_RETURN_IF_ERROR(fit_geometry_image_positions(mesh, S, &image));
   return image;
 }
 

@@ -90,3 +90,37 @@ TEST_CASE("spherekit convert: a bad --size is a usage error and writes nothing",
   CHECK(r2.err.find("blob.sphere.obj") != std::string::npos);
   CHECK_FALSE(fs::exists(dir + "/out.exr"));
 }
+
+TEST_CASE("spherekit convert --positions: fitted texels beat sampled ones; a bad value writes nothing", "[convert]") {
+  const std::string dir = test::temp_dir("convert_cli_positions"), cap = test::temp_dir("convert_cli_positions_cap");
+  write_inputs(dir);
+  const std::string in = quote(dir + "/blob.obj") + " " + quote(dir + "/blob.sphere.obj");
+  double psnr[2] = {0, 0};
+  const char* modes[2] = {"sampled", "fit"};
+  for (int k = 0; k < 2; ++k) {
+    const std::string out = dir + "/" + modes[k];
+    const CliRun r = run_cli("convert " + in + " -o " + quote(out + ".exr") + " --size 33 --positions " + modes[k] +
+                                 " --report " + quote(out + ".json") + " --psnr-samples 50000",
+                             cap);
+    INFO(r.err);
+    REQUIRE(r.exit_code == 0);
+    const auto report = nlohmann::json::parse(slurp(out + ".json"));
+    CHECK(report.at("positions") == modes[k]);
+    psnr[k] = report.at("psnr_db").get<double>();
+  }
+  CAPTURE(psnr[0], psnr[1]);
+  CHECK(psnr[1] > psnr[0] + 3);
+  // The default is the fit.
+  const CliRun d = run_cli("convert " + in + " -o " + quote(dir + "/default.exr") + " --size 33 --report " +
+                               quote(dir + "/default.json") + " --psnr-samples 0",
+                           cap);
+  REQUIRE(d.exit_code == 0);
+  CHECK(nlohmann::json::parse(slurp(dir + "/default.json")).at("positions") == "fit");
+  CHECK(slurp(dir + "/default.exr") == slurp(dir + "/fit.exr"));
+  // A bad value: usage error, one line, nothing written.
+  const CliRun bad = run_cli("convert " + in + " -o " + quote(dir + "/bad.exr") + " --positions nearest", cap);
+  CHECK(bad.exit_code == 2);
+  CHECK(bad.err.find("--positions") != std::string::npos);
+  CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
+  CHECK_FALSE(fs::exists(dir + "/bad.exr"));
+}

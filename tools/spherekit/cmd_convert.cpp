@@ -55,9 +55,17 @@ Result<std::vector<std::string>> write_geometry_image_previews(const GeometryIma
   return written;
 }
 
+GeometryImageOptions geometry_image_options(const ConvertArgs& a) {
+  GeometryImageOptions o;
+  o.fit_positions = a.positions == "fit";
+  return o;
+}
+
 Status check_convert_flags(const ConvertArgs& a) {
   if (!is_geometry_image_size(a.size) || a.size > 16385)
     return Status(ErrorCode::InvalidArgument, strprintf("--size %d is not 2^k+1 (e.g. 65, 129, 257, 513)", a.size));
+  if (a.positions != "fit" && a.positions != "sampled")
+    return Status(ErrorCode::InvalidArgument, "--positions must be fit or sampled, not '" + a.positions + "'");
   if (a.psnr_samples < 0) return Status(ErrorCode::InvalidArgument, "--psnr-samples must be >= 0");
   if (a.lods < 0 || a.lods > 30 || (a.lods > 0 && ((a.size - 1) >> (a.lods - 1)) < 2))
     return Status(ErrorCode::InvalidArgument,
@@ -182,7 +190,7 @@ int run_convert(const ConvertArgs& a) {
   const double read_seconds = m.read_seconds + read_sphere.seconds();
 
   Stopwatch sample_time;
-  auto sampled = sample_geometry_image(m.mesh, map->S, a.size);
+  auto sampled = sample_geometry_image(m.mesh, map->S, a.size, geometry_image_options(a));
   if (!sampled.ok()) return print_error(with_file(sampled.status(), a.mesh));
   const GeometryImage& image = sampled.value();
   const double sample_seconds = sample_time.seconds();
@@ -272,6 +280,7 @@ int run_convert(const ConvertArgs& a) {
     j["V"] = m.mesh.V.rows();
     j["F"] = m.mesh.F.rows();
     j["size"] = a.size;
+    j["positions"] = a.positions;
     j["layout"] = "octahedral";
     j["texels_in_holes"] = image.texels_in_holes;
     j["previews"] = previews.value();
@@ -435,6 +444,9 @@ void register_convert(CLI::App& app) {
   cmd->add_option("--size,--gi", args->size, "image size N = 2^k+1 (default 257)");
   cmd->add_option("--remesh", args->remesh, "also write the remesh defined by the image (.obj .ply)");
   cmd->add_option("--report", args->report, "also write a JSON report here");
+  cmd->add_option("--positions", args->positions,
+                  "texel positions: fit (least-squares fit of the surface, the lower remesh error; default) or "
+                  "sampled (each texel the surface point it samples)");
   cmd->add_option("--psnr-samples", args->psnr_samples,
                   "points sampled per direction for the PSNR (0: skip it; default 400000)");
   cmd->add_option("--lods", args->lods, "also write this many glTF levels of detail (default 0: none)");

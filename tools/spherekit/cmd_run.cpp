@@ -125,7 +125,9 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
   // it (faces spanning holes of the mesh are left out of the PSNR).
   const std::string gim_path = (out_dir / (name + ".gim" + std::to_string(kGeometryImageSize) + ".exr")).string();
   Stopwatch gim_time;
-  auto sampled = sample_geometry_image(m.mesh, r.map.S, kGeometryImageSize);
+  GeometryImageOptions gio;
+  gio.fit_positions = true;  // convert's default
+  auto sampled = sample_geometry_image(m.mesh, r.map.S, kGeometryImageSize, gio);
   if (!sampled.ok()) return fail(with_file(sampled.status(), path));
   const GeometryImage& image = sampled.value();
   const TriMesh remesh = geometry_image_mesh(image);

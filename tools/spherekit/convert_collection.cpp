@@ -78,7 +78,7 @@ int run_convert_collection(const ConvertArgs& a) {
       j["V"] = m.mesh.V.rows();
       j["F"] = m.mesh.F.rows();
       Stopwatch t;
-      auto sampled = sample_geometry_image(m.mesh, m.map.S, a.size);
+      auto sampled = sample_geometry_image(m.mesh, m.map.S, a.size, geometry_image_options(a));
       if (!sampled.ok()) return with_file(sampled.status(), m.source);
       out.image = std::move(sampled).value();
       const std::string exr = m.name + ".exr";
@@ -193,6 +193,7 @@ int run_convert_collection(const ConvertArgs& a) {
     report["feature_texels"] = std::move(feats);
     report["collection"] = fs::absolute(a.collection).lexically_normal().string();
     report["size"] = a.size;
+    report["positions"] = a.positions;
     report["layout"] = "octahedral";
     Json list = Json::array();
     for (MemberOutput& o : outputs) list.push_back(std::move(o.json));

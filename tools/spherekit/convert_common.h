@@ -22,6 +22,7 @@ struct ConvertArgs {
   std::string remesh;
   std::string report;
   int size = 257;
+  std::string positions = "fit";  // texel positions: fit (least squares) or sampled
   int psnr_samples = RemeshErrorOptions{}.samples;
   int lods = 0;  // glTF levels of detail (0: none)
   int cage = 0;  // Catmull-Clark cage: quads per cube-face edge (0: none)
@@ -30,6 +31,9 @@ struct ConvertArgs {
   convert::QuantizationBudget budget;
   bool quiet = false;
 };
+
+/// The sampling options --positions asks for.
+GeometryImageOptions geometry_image_options(const ConvertArgs& a);
 
 /// Flags that are wrong whatever the input: checked before anything is read or written.
 Status check_convert_flags(const ConvertArgs& a);

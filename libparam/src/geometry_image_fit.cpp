@@ -31,21 +31,23 @@ namespace spherekit {
 namespace {
 
 // Barycentric coordinates of domain point (u, v) in the image grid's triangle containing it,
-// with the grid's split rule (geometry_image_grid_faces): the texel indices (i * n + j) of
-// the corners and their weights.
-void grid_triangle(double u, double v, int n, std::array<int, 3>& corner, std::array<double, 3>& w) {
+// with the grid's split rule (geometry_image_grid_faces): the triangle and the weights of its
+// corners, in the corner order of that face.
+// `tri` gets the triangle's index in geometry_image_grid_faces (two per cell, same order).
+void grid_triangle(double u, double v, int n, int& tri, std::array<double, 3>& w) {
   const int m = n - 1, half = m / 2;
   const double x = (u + 1) * 0.5 * m, y = (v + 1) * 0.5 * m;
   const int j = std::clamp(static_cast<int>(std::floor(x)), 0, m - 1);
   const int i = std::clamp(static_cast<int>(std::floor(y)), 0, m - 1);
   const double s = std::clamp(x - j, 0.0, 1.0), t = std::clamp(y - i, 0.0, 1.0);
-  const int A = i * n + j, B = i * n + j + 1, C = (i + 1) * n + j + 1, D = (i + 1) * n + j;
+  // Corners A (i,j), B (i,j+1), C (i+1,j+1), D (i+1,j); faces ABD, BCD or ABC, ACD.
+  const int cell = 2 * (i * m + j);
   if ((j >= half) == (i >= half)) {
-    if (s + t <= 1) corner = {A, B, D}, w = {1 - s - t, s, t};
-    else corner = {B, C, D}, w = {1 - t, s + t - 1, 1 - s};
+    if (s + t <= 1) tri = cell, w = {1 - s - t, s, t};
+    else tri = cell + 1, w = {1 - t, s + t - 1, 1 - s};
   } else {
-    if (s >= t) corner = {A, B, C}, w = {1 - s, s - t, t};
-    else corner = {A, C, D}, w = {1 - t, s, t - s};
+    if (s >= t) tri = cell, w = {1 - s, s - t, t};
+    else tri = cell + 1, w = {1 - t, s, t - s};
   }
 }
 
@@ -88,11 +90,11 @@ Status fit_geometry_image_positions(const TriMesh& mesh, const RowMat3d& S, Geom
   if (!(total_surface > 0) || !(total_sphere > 0)) return Status();  // nothing to fit: keep the samples
   const double target = 16.0 * 2.0 * (n - 1) * (n - 1);
 
-  // Normal equations, accumulated per grid triangle corner pair in a dense-per-texel map:
-  // the grid couples a texel only with its neighbours, so triplets suffice.
-  std::vector<Eigen::Triplet<double>> triplets;
+  // Normal equations, accumulated per grid triangle (its 3 x 3 block and right-hand sides)
+  // and assembled once: memory in grid triangles, not in samples.
+  const RowMat3i grid = geometry_image_grid_faces(n);
+  std::vector<std::array<double, 9>> block(static_cast<std::size_t>(grid.rows()), std::array<double, 9>{});
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(unknowns, 3);
-  std::vector<double> diag(nu, 0.0);
   std::vector<Eigen::Vector3d> lattice;
   int last_m = -1;
   for (Eigen::Index f = 0; f < nf; ++f) {
@@ -109,22 +111,33 @@ Status fit_geometry_image_positions(const TriMesh& mesh, const RowMat3d& S, Geom
       const Eigen::Vector3d q = beta.x() * qa + beta.y() * qb + beta.z() * qc;
       if (!(q.norm() > 0)) continue;
       const Eigen::Vector2d uv = sphere_to_octahedral(q);
-      std::array<int, 3> corner;
+      int tri = 0;
       std::array<double, 3> gw;
-      grid_triangle(uv.x(), uv.y(), n, corner, gw);
+      grid_triangle(uv.x(), uv.y(), n, tri, gw);
       const Eigen::Vector3d p = beta.x() * a + beta.y() * b + beta.z() * c;
+      auto& blk = block[static_cast<std::size_t>(tri)];
       for (int r = 0; r < 3; ++r) {
-        const int row = id[static_cast<std::size_t>(corner[static_cast<std::size_t>(r)])];
-        rhs.row(row) += w * gw[static_cast<std::size_t>(r)] * p.transpose();
-        for (int col = 0; col < 3; ++col) {
-          const int cid = id[static_cast<std::size_t>(corner[static_cast<std::size_t>(col)])];
-          const double v = w * gw[static_cast<std::size_t>(r)] * gw[static_cast<std::size_t>(col)];
-          if (row == cid) diag[static_cast<std::size_t>(row)] += v;
-          else triplets.emplace_back(row, cid, v);
-        }
+        const double wr = w * gw[static_cast<std::size_t>(r)];
+        rhs.row(id[static_cast<std::size_t>(grid(tri, r))]) += wr * p.transpose();
+        for (int col = 0; col < 3; ++col) blk[static_cast<std::size_t>(3 * r + col)] += wr * gw[static_cast<std::size_t>(col)];
       }
     }
   }
+  std::vector<Eigen::Triplet<double>> triplets;
+  std::vector<double> diag(nu, 0.0);
+  for (Eigen::Index t = 0; t < grid.rows(); ++t) {
+    const auto& blk = block[static_cast<std::size_t>(t)];
+    for (int r = 0; r < 3; ++r)
+      for (int col = 0; col < 3; ++col) {
+        const double v = blk[static_cast<std::size_t>(3 * r + col)];
+        if (v == 0) continue;
+        const int row = id[static_cast<std::size_t>(grid(t, r))], cid = id[static_cast<std::size_t>(grid(t, col))];
+        if (row == cid) diag[static_cast<std::size_t>(row)] += v;
+        else triplets.emplace_back(row, cid, v);
+      }
+  }
+  block.clear();
+  block.shrink_to_fit();
   // Anchor: lambda relative to the mean data weight per texel.
   double mean_diag = 0;
   for (double d : diag) mean_diag += d;

@@ -36,10 +36,6 @@ namespace fs = std::filesystem;
 namespace spherekit::cli {
 namespace {
 
-// The geometry image the main job builds per mesh (as `spherekit convert --size 129`), and
-// the PSNR sample count per direction: lower than convert's default so the job stays fast.
-constexpr int kGeometryImageSize = 129;
-constexpr int kGeometryImagePsnrSamples = 100000;
 // glTF levels of detail per mesh from that image (129, 65, 33), for the page's 3-D view.
 constexpr int kGeometryImageLods = 3;
 
@@ -123,18 +119,17 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
 
   // The octahedral geometry image of the map and its remesh PSNR, exactly as `convert` does
   // it (faces spanning holes of the mesh are left out of the PSNR).
-  const std::string gim_path = (out_dir / (name + ".gim" + std::to_string(kGeometryImageSize) + ".exr")).string();
+  const std::string gim_path = (out_dir / (name + ".gim" + std::to_string(kRunImageSize) + ".exr")).string();
   Stopwatch gim_time;
-  GeometryImageOptions gio;
-  gio.fit_positions = true;  // convert's default
-  auto sampled = sample_geometry_image(m.mesh, r.map.S, kGeometryImageSize, gio);
+  const GeometryImageOptions gio = geometry_image_options(ConvertArgs{});  // convert's defaults
+  auto sampled = sample_geometry_image(m.mesh, r.map.S, kRunImageSize, gio);
   if (!sampled.ok()) return fail(with_file(sampled.status(), path));
   const GeometryImage& image = sampled.value();
   const TriMesh remesh = geometry_image_mesh(image);
   if (Status s = convert::write_geometry_image_exr(gim_path, image, {path, sphere_path}); !s.ok()) return fail(s);
   const bool has_holes = image.texels_in_holes > 0;
   RemeshErrorOptions psnr_opts;
-  psnr_opts.samples = kGeometryImagePsnrSamples;
+  psnr_opts.samples = kRunPsnrSamples;
   const RemeshError err = remesh_error(m.mesh, remesh, psnr_opts, geometry_image_hole_faces(image));
   // Previews and levels of detail (as `convert --lods`), for people and for the page.
   const std::string gim_prefix = gltf_prefix(gim_path);
@@ -156,7 +151,7 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
     page_lods.push_back(fs::path(f).filename().string());
   }
   out.json["geometry_image"] = Json{{"file", gim_path},
-                                    {"size", kGeometryImageSize},
+                                    {"size", kRunImageSize},
                                     {"psnr_db", number_or_null(err.psnr)},
                                     {"psnr_excludes_hole_faces", has_holes},
                                     {"previews", previews.value()},

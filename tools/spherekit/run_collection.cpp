@@ -25,12 +25,10 @@ namespace {
 
 // What the main job converts each member into: images large enough to look at, three levels
 // of detail (129, 65, 33), a cage of 8 x 8 quads per cube face with 9 x 9 scalar displacement
-// samples per quad, and PSNRs from 100000 samples per direction (as for the per-mesh images).
-constexpr int kImageSize = 129;
+// samples per quad, and PSNRs from kRunPsnrSamples samples per direction (run_job.h).
 constexpr int kLods = 3;
 constexpr int kCage = 8;
 constexpr int kCageTile = 9;
-constexpr int kPsnrSamples = 100000;
 
 Result<Json> read_json_file(const std::string& path) {
   SPHEREKIT_ASSIGN_OR_RETURN(std::string text, formats::read_file(path));
@@ -65,11 +63,11 @@ int run_collection_stages(const std::string& col_dir, const std::string& out_dir
   ConvertArgs ca;
   ca.collection = col_dir;
   ca.output = (fs::path(out_dir) / "assets").string();
-  ca.size = kImageSize;
+  ca.size = kRunImageSize;
   ca.lods = kLods;
   ca.cage = kCage;
   ca.cage_tile = kCageTile;
-  ca.psnr_samples = kPsnrSamples;
+  ca.psnr_samples = kRunPsnrSamples;
   ca.quiet = quiet;
   if (int code = run_convert_collection(ca); code != 0) return code;
   auto conv = read_json_file((fs::path(ca.output) / "convert_report.json").string());

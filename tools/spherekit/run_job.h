@@ -7,6 +7,12 @@
 
 namespace spherekit::cli {
 
+/// The geometry-image size of the main job, per mesh and per collection member (as
+/// `convert --gi 129`), and its PSNR sample count per direction: lower than convert's default
+/// so the job stays fast.
+constexpr int kRunImageSize = 129;
+constexpr int kRunPsnrSamples = 100000;
+
 /// The collection half of the main job (run_collection.cpp): with the consistent collection
 /// in `col_dir`, converts every member into OUT/assets (as `convert --collection`: 129 x 129
 /// images with PNG previews, 3 glTF levels of detail, cage 8 with 9 x 9 scalar displacement)

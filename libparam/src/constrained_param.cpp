@@ -18,6 +18,7 @@
 #include "detail/rotation.h"
 #include "detail/sphere_embedding.h"
 #include "detail/stage_util.h"
+#include "detail/untangle_patch.h"
 #include "spherekit/check_mesh.h"
 #include "spherekit/fill_holes.h"
 #include "spherekit/metrics.h"
@@ -191,11 +192,40 @@ std::vector<int> flipped_faces(const FaceSet& fs, const RowMat3d& S) {
   return bad;
 }
 
-// Untangling of a fold: a thin input face whose two Steiner-split halves bulged across a path
-// comes back inverted with every corner's kernel empty, so no single vertex move repairs it.
-// The soft untangling moves such corners to their best compromise points and lets the
-// neighbourhood follow. On failure S is restored (a soft sweep may have spread the fold).
-bool untangle_fold(const FaceSet& fs, const std::vector<char>& fixed, const std::vector<int>& bad, RowMat3d* S) {
+// The flipped faces around the given faces (within `rings` rings of their corners).
+std::vector<int> flipped_near(const FaceSet& fs, const RowMat3d& S, const std::vector<int>& around, int rings) {
+  std::vector<int> verts;
+  for (int f : around)
+    for (int v : fs.F[static_cast<size_t>(f)]) verts.push_back(v);
+  for (int r = 0; r < rings; ++r) {
+    std::vector<int> more = verts;
+    for (int v : verts)
+      for (int f : fs.vf[static_cast<size_t>(v)])
+        for (int w : fs.F[static_cast<size_t>(f)]) more.push_back(w);
+    std::sort(more.begin(), more.end());
+    more.erase(std::unique(more.begin(), more.end()), more.end());
+    verts.swap(more);
+  }
+  std::vector<int> bad;
+  for (int v : verts)
+    for (int f : fs.vf[static_cast<size_t>(v)])
+      if (fs.flipped(S, f)) bad.push_back(f);
+  std::sort(bad.begin(), bad.end());
+  bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
+  return bad;
+}
+
+// Untangling of a fold that moving one vertex at a time cannot repair: a thin input face
+// whose two Steiner-split halves bulged across a path comes back inverted with every corner's
+// kernel empty. First the patch around it is untangled as a whole in a planar chart
+// (detail::untangle_patch), on growing patches; then, as a last resort, the soft untangling
+// moves such corners to their best compromise points and lets the neighbourhood follow (on
+// failure S is restored, a soft sweep may have spread the fold).
+bool untangle_fold(const FaceSet& fs, const std::vector<Eigen::Vector3d>& X, const std::vector<char>& fixed,
+                   const std::vector<int>& bad, RowMat3d* S) {
+  const detail::PatchMesh pm{&fs.F, &fs.alive, &fs.vf};
+  for (int rings : {2, 4, 8, 16})
+    if (detail::untangle_patch(pm, X, fixed, bad, rings, S)) return true;
   const RowMat3d saved = *S;
   if (untangle(fs, fixed, bad, S, /*soft=*/true)) return true;
   *S = saved;
@@ -229,13 +259,22 @@ int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<ch
     if (!merged.empty()) {
       ++untangled;
       // A face left flipped here may still be merged again below.
-      if (!untangle(fs, fixed_all, merged, S)) untangle_fold(fs, fixed_all, flipped_faces(fs, *S), S);
+      if (!untangle(fs, fixed_all, merged, S)) {
+        std::vector<int> bad = flipped_near(fs, *S, merged, 3);
+        if (!bad.empty()) untangle_fold(fs, net.X, fixed_all, bad, S);
+      }
     }
   }
-  // Whatever is still flipped at the end: untangle once more over the final faces.
+  // Whatever is still flipped at the end: untangle once more over the final faces, fold by
+  // fold.
   std::vector<int> bad = flipped_faces(fs, *S);
-  if (!bad.empty() && !untangle(fs, fixed_all, bad, S) && !untangle_fold(fs, fixed_all, flipped_faces(fs, *S), S))
-    return -1;
+  for (size_t guard = 2 * bad.size() + 8; !bad.empty(); --guard) {
+    if (guard == 0) return -1;
+    std::vector<int> seed = flipped_near(fs, *S, {bad.front()}, 3);
+    if (!untangle(fs, fixed_all, seed, S) && !untangle_fold(fs, net.X, fixed_all, flipped_near(fs, *S, seed, 3), S))
+      return -1;
+    bad = flipped_faces(fs, *S);
+  }
   return untangled;
 }
 
@@ -457,11 +496,13 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     in.base_positions.row(fv[static_cast<size_t>(i)]) = targets[static_cast<size_t>(i)].transpose();
     in.fixed[static_cast<size_t>(fv[static_cast<size_t>(i)])] = 1;
   }
+  // The network mesh gets the full final passes although another runs on the input
+  // connectivity below: a map relaxed only coarse-to-fine keeps needle-shaped regions along
+  // the paths, and merging their Steiner vertices away there folds faces that no local
+  // untangling repairs (armadillo with 64 features).
   const bool has_steiner = nn > n;
-  detail::OptimizerSettings net_settings = settings;
-  if (has_steiner) net_settings.final_iter = 1;  // the final pass runs on the input connectivity below
   RowMat3d Snet;
-  SPHEREKIT_RETURN_IF_ERROR(detail::embed_coarse_to_fine(in, net_settings, progress, &Snet, nullptr));
+  SPHEREKIT_RETURN_IF_ERROR(detail::embed_coarse_to_fine(in, settings, progress, &Snet, nullptr));
 
   // 7. Drop the Steiner vertices: the input's faces are unions of network faces, valid as
   //    long as each split edge's quad stays convex on the sphere (checked exactly).

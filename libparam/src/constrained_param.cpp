@@ -130,6 +130,7 @@ struct FaceSet {
   void attach(int f) {
     for (int v : F[static_cast<size_t>(f)]) vf[static_cast<size_t>(v)].push_back(f);
   }
+  detail::PatchMesh patch() const { return {&F, &vf}; }
   bool flipped(const RowMat3d& S, int f) const {
     const auto& c = F[static_cast<size_t>(f)];
     return orient3d_origin(S.row(c[0]).data(), S.row(c[1]).data(), S.row(c[2]).data()) <= 0;
@@ -144,20 +145,10 @@ struct FaceSet {
 bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int> bad, RowMat3d* S,
               bool soft = false) {
   for (int sweep = 0; sweep < 120 && !bad.empty(); ++sweep) {
-    std::vector<int> cand;
+    std::vector<int> corners;
     for (int f : bad)
-      for (int v : fs.F[static_cast<size_t>(f)]) cand.push_back(v);
-    for (int grow = 0; grow < sweep / 6; ++grow) {
-      std::vector<int> more = cand;
-      for (int v : cand)
-        for (int f : fs.vf[static_cast<size_t>(v)])
-          for (int w : fs.F[static_cast<size_t>(f)]) more.push_back(w);
-      cand.swap(more);
-      std::sort(cand.begin(), cand.end());
-      cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
-    }
-    std::sort(cand.begin(), cand.end());
-    cand.erase(std::unique(cand.begin(), cand.end()), cand.end());
+      for (int v : fs.F[static_cast<size_t>(f)]) corners.push_back(v);
+    const std::vector<int> cand = detail::grow_rings(fs.patch(), std::move(corners), sweep / 6);
     for (int v : cand) {
       if (fixed[static_cast<size_t>(v)]) continue;
       std::vector<std::array<int, 2>> ring;
@@ -194,20 +185,11 @@ std::vector<int> flipped_faces(const FaceSet& fs, const RowMat3d& S) {
 
 // The flipped faces around the given faces (within `rings` rings of their corners).
 std::vector<int> flipped_near(const FaceSet& fs, const RowMat3d& S, const std::vector<int>& around, int rings) {
-  std::vector<int> verts;
+  std::vector<int> corners;
   for (int f : around)
-    for (int v : fs.F[static_cast<size_t>(f)]) verts.push_back(v);
-  for (int r = 0; r < rings; ++r) {
-    std::vector<int> more = verts;
-    for (int v : verts)
-      for (int f : fs.vf[static_cast<size_t>(v)])
-        for (int w : fs.F[static_cast<size_t>(f)]) more.push_back(w);
-    std::sort(more.begin(), more.end());
-    more.erase(std::unique(more.begin(), more.end()), more.end());
-    verts.swap(more);
-  }
+    for (int v : fs.F[static_cast<size_t>(f)]) corners.push_back(v);
   std::vector<int> bad;
-  for (int v : verts)
+  for (int v : detail::grow_rings(fs.patch(), std::move(corners), rings))
     for (int f : fs.vf[static_cast<size_t>(v)])
       if (fs.flipped(S, f)) bad.push_back(f);
   std::sort(bad.begin(), bad.end());
@@ -223,9 +205,8 @@ std::vector<int> flipped_near(const FaceSet& fs, const RowMat3d& S, const std::v
 // failure S is restored, a soft sweep may have spread the fold).
 bool untangle_fold(const FaceSet& fs, const std::vector<Eigen::Vector3d>& X, const std::vector<char>& fixed,
                    const std::vector<int>& bad, RowMat3d* S) {
-  const detail::PatchMesh pm{&fs.F, &fs.alive, &fs.vf};
   for (int rings : {2, 4, 8, 16})
-    if (detail::untangle_patch(pm, X, fixed, bad, rings, S)) return true;
+    if (detail::untangle_patch(fs.patch(), X, fixed, bad, rings, S)) return true;
   const RowMat3d saved = *S;
   if (untangle(fs, fixed, bad, S, /*soft=*/true)) return true;
   *S = saved;

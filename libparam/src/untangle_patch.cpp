@@ -51,6 +51,14 @@ double chi_derivative(double d, double eps) {
   return d >= 0 ? 0.5 * (1 + d / root) : 0.5 * eps * eps / (root * (root - d));
 }
 
+// All local positions: the unknowns x for the free vertices, the fixed ones as they are.
+std::vector<Eigen::Vector2d> positions(const PatchProblem& p, const Eigen::VectorXd& x) {
+  std::vector<Eigen::Vector2d> u = p.u;
+  for (size_t v = 0; v < u.size(); ++v)
+    if (int k = p.var[v]; k >= 0) u[v] = x.segment<2>(2 * k);
+  return u;
+}
+
 Eigen::Matrix2d jacobian(const PatchProblem& p, const std::vector<Eigen::Vector2d>& u, size_t t) {
   const auto& c = p.face[t];
   Eigen::Matrix2d du;
@@ -61,9 +69,7 @@ Eigen::Matrix2d jacobian(const PatchProblem& p, const std::vector<Eigen::Vector2
 
 // Energy and gradient at the unknowns x (2 per free vertex).
 double energy(const PatchProblem& p, const Eigen::VectorXd& x, double eps, Eigen::VectorXd* grad) {
-  std::vector<Eigen::Vector2d> u = p.u;
-  for (size_t v = 0; v < u.size(); ++v)
-    if (int k = p.var[v]; k >= 0) u[v] = x.segment<2>(2 * k);
+  const std::vector<Eigen::Vector2d> u = positions(p, x);
   if (grad) grad->setZero(x.size());
   double e = 0;
   for (size_t t = 0; t < p.face.size(); ++t) {
@@ -90,9 +96,7 @@ double energy(const PatchProblem& p, const Eigen::VectorXd& x, double eps, Eigen
 }
 
 double min_det(const PatchProblem& p, const Eigen::VectorXd& x) {
-  std::vector<Eigen::Vector2d> u = p.u;
-  for (size_t v = 0; v < u.size(); ++v)
-    if (int k = p.var[v]; k >= 0) u[v] = x.segment<2>(2 * k);
+  const std::vector<Eigen::Vector2d> u = positions(p, x);
   double m = std::numeric_limits<double>::infinity();
   for (size_t t = 0; t < p.face.size(); ++t) m = std::min(m, jacobian(p, u, t).determinant());
   return m;
@@ -162,33 +166,32 @@ void minimize(const PatchProblem& p, double eps, Eigen::VectorXd* x) {
 
 }  // namespace
 
+std::vector<int> grow_rings(const PatchMesh& mesh, std::vector<int> verts, int rings) {
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  for (int r = 0; r < rings; ++r) {
+    std::vector<int> more = verts;
+    for (int v : verts)
+      for (int f : (*mesh.vf)[static_cast<size_t>(v)])
+        for (int w : (*mesh.F)[static_cast<size_t>(f)]) more.push_back(w);
+    std::sort(more.begin(), more.end());
+    more.erase(std::unique(more.begin(), more.end()), more.end());
+    verts.swap(more);
+  }
+  return verts;
+}
+
 bool untangle_patch(const PatchMesh& mesh, const std::vector<Eigen::Vector3d>& X, const std::vector<char>& fixed,
                     const std::vector<int>& bad, int rings, RowMat3d* S, UntanglePatchStats* stats) {
   const auto& F = *mesh.F;
   const auto& vf = *mesh.vf;
-  auto alive = [&](int f) { return !mesh.alive || (*mesh.alive)[static_cast<size_t>(f)]; };
   const size_t nv = vf.size();
 
   // The moving vertices: the bad faces' corners grown by `rings` face rings.
-  std::vector<char> in_set(nv, 0);
-  std::vector<int> grown;
+  std::vector<int> corners;
   for (int f : bad)
-    for (int v : F[static_cast<size_t>(f)])
-      if (!in_set[static_cast<size_t>(v)]) {
-        in_set[static_cast<size_t>(v)] = 1;
-        grown.push_back(v);
-      }
-  for (int r = 0; r < rings; ++r) {
-    const size_t end = grown.size();
-    for (size_t i = 0; i < end; ++i)
-      for (int f : vf[static_cast<size_t>(grown[i])])
-        for (int w : F[static_cast<size_t>(f)])
-          if (!in_set[static_cast<size_t>(w)]) {
-            in_set[static_cast<size_t>(w)] = 1;
-            grown.push_back(w);
-          }
-  }
-  std::sort(grown.begin(), grown.end());
+    for (int v : F[static_cast<size_t>(f)]) corners.push_back(v);
+  const std::vector<int> grown = grow_rings(mesh, std::move(corners), rings);
 
   // Local numbering: the free vertices, then the other corners of their faces.
   std::vector<int> local(nv, -1), global;
@@ -203,7 +206,7 @@ bool untangle_patch(const PatchMesh& mesh, const std::vector<Eigen::Vector3d>& X
   std::vector<int> faces;
   for (int i = 0; i < p.num_vars; ++i)
     for (int f : vf[static_cast<size_t>(global[static_cast<size_t>(i)])])
-      if (alive(f)) faces.push_back(f);
+      faces.push_back(f);
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   for (int f : faces)

@@ -76,7 +76,7 @@ TEST_CASE("untangle_patch undoes a fold that inverts dozens of faces", "[untangl
   fixed[static_cast<size_t>(feature)] = 1;
   const Eigen::RowVector3d feature_at = S.row(feature);
 
-  detail::PatchMesh pm{&soup.F, nullptr, &soup.vf};
+  detail::PatchMesh pm{&soup.F, &soup.vf};
   detail::UntanglePatchStats st;
   bool ok = false;
   for (int rings : {2, 4, 8})
@@ -101,7 +101,7 @@ TEST_CASE("untangle_patch leaves the map unchanged when it cannot succeed", "[un
   std::vector<int> bad = soup.flipped(S);
   REQUIRE(!bad.empty());
   const RowMat3d folded = S;
-  detail::PatchMesh pm{&soup.F, nullptr, &soup.vf};
+  detail::PatchMesh pm{&soup.F, &soup.vf};
 
   SECTION("every vertex of the patch is fixed") {
     std::vector<char> fixed(static_cast<size_t>(m.V.rows()), 1);
@@ -129,7 +129,7 @@ TEST_CASE("untangle_patch is deterministic", "[untangle]") {
   std::vector<int> bad = soup.flipped(S);
   REQUIRE(!bad.empty());
   std::vector<char> fixed(static_cast<size_t>(m.V.rows()), 0);
-  detail::PatchMesh pm{&soup.F, nullptr, &soup.vf};
+  detail::PatchMesh pm{&soup.F, &soup.vf};
   RowMat3d A = S, B = S;
   REQUIRE(detail::untangle_patch(pm, soup.X, fixed, bad, 4, &A));
   REQUIRE(detail::untangle_patch(pm, soup.X, fixed, bad, 4, &B));

@@ -13,12 +13,15 @@
 
 namespace spherekit::detail {
 
-/// A face set being edited: faces, which of them are alive, and per vertex its alive faces.
+/// A face set being edited: faces, and per vertex the faces in use around it (faces that no
+/// vertex lists are dead and ignored).
 struct PatchMesh {
   const std::vector<std::array<int, 3>>* F = nullptr;
-  const std::vector<char>* alive = nullptr;  ///< nullptr: every face is alive
   const std::vector<std::vector<int>>* vf = nullptr;
 };
+
+/// The given vertices and every vertex within `rings` face rings of them, sorted, unique.
+std::vector<int> grow_rings(const PatchMesh& mesh, std::vector<int> verts, int rings);
 
 struct UntanglePatchStats {
   int free_vertices = 0;

@@ -73,7 +73,7 @@ Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector
 // is empty and `compromise` is given, it receives the best max-min point found (some ring
 // faces stay negative there, by as little as possible).
 bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring, const Eigen::Vector3d& start,
-                  Eigen::Vector3d* out, Eigen::Vector3d* compromise = nullptr) {
+                  Eigen::Vector3d* out, Eigen::Vector3d* compromise = nullptr, long* work = nullptr) {
   std::vector<Eigen::Vector3d> nrm;
   for (const auto& r : ring) {
     Eigen::Vector3d n = S.row(r[0]).transpose().cross(S.row(r[1]).transpose());
@@ -90,6 +90,7 @@ bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring
   double best_min = -1e300;
   double step = 0.1;
   for (int it = 0; it < 2000; ++it) {
+    if (work) ++*work;
     double best = 1e300;
     size_t arg = 0;
     for (size_t k = 0; k < nrm.size(); ++k) {
@@ -137,6 +138,9 @@ struct FaceSet {
   }
 };
 
+constexpr int kMaxFailedFolds = 8;  // folds left flipped while undoing splits, before giving up
+constexpr long kUntangleWork = 4'000'000;  // subgradient steps per untangling call (~0.2 s)
+
 // Local untangling: moves the free corners of the given flipped faces (and, when that is not
 // enough, vertices in growing rings around them) to points inside their spherical kernels.
 // A vertex whose kernel is empty stays, unless `soft`: then it goes to its best compromise
@@ -144,7 +148,11 @@ struct FaceSet {
 // successive sweeps. Returns true when no face around them is flipped any more.
 bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int> bad, RowMat3d* S,
               bool soft = false) {
-  for (int sweep = 0; sweep < 120 && !bad.empty(); ++sweep) {
+  // A fold that the sweeps cannot undo would otherwise keep them busy for minutes (growing
+  // rings, a full subgradient run per vertex with an empty kernel): the work is bounded, in
+  // subgradient steps, so that the caller's next remedy gets its turn.
+  long work = 0;
+  for (int sweep = 0; sweep < 120 && !bad.empty() && work < kUntangleWork; ++sweep) {
     std::vector<int> corners;
     for (int f : bad)
       for (int v : fs.F[static_cast<size_t>(f)]) corners.push_back(v);
@@ -162,7 +170,7 @@ bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int
       }
       Eigen::Vector3d x, y;
       if (!(mean.norm() > 0)) continue;
-      if (kernel_point(*S, ring, mean, &x, soft ? &y : nullptr)) S->row(v) = x.transpose();
+      if (kernel_point(*S, ring, mean, &x, soft ? &y : nullptr, &work)) S->row(v) = x.transpose();
       else if (soft) S->row(v) = y.transpose();
     }
     std::vector<int> still;
@@ -197,17 +205,26 @@ std::vector<int> flipped_near(const FaceSet& fs, const RowMat3d& S, const std::v
   return bad;
 }
 
-// Untangling of a fold that moving one vertex at a time cannot repair: a thin input face
-// whose two Steiner-split halves bulged across a path comes back inverted with every corner's
-// kernel empty. First the patch around it is untangled as a whole in a planar chart
-// (detail::untangle_patch), on growing patches; then, as a last resort, the soft untangling
-// moves such corners to their best compromise points and lets the neighbourhood follow (on
-// failure S is restored, a soft sweep may have spread the fold).
+// Untangling of a fold left by undoing a split (a thin input face whose two Steiner-split
+// halves bulged across a path comes back inverted). Moving the fold's corners one at a time
+// into their kernels (untangle) repairs it fast but leaves slivers, which the stretch
+// optimizer afterwards cannot open (armadillo with 64 features: efficiency 0.07 instead of
+// 0.28); untangling the patch around it as a whole in a planar chart (detail::untangle_patch)
+// gives shapes close to the input's. So patches come first, and the soft untangling, which
+// moves corners with empty kernels to their best compromise points, comes last (on failure
+// S is restored: a soft sweep may have spread the fold).
 bool untangle_fold(const FaceSet& fs, const std::vector<Eigen::Vector3d>& X, const std::vector<char>& fixed,
                    const std::vector<int>& bad, RowMat3d* S) {
-  for (int rings : {2, 4, 8, 16})
+  // Small patches first: when they succeed the fold's neighbourhood gets shapes close to the
+  // input's. The vertex-by-vertex untangling is cheap and often enough where a small patch
+  // is boxed in by its fixed outline; larger patches and the soft untangling come last.
+  for (int rings : {1, 2})
     if (detail::untangle_patch(fs.patch(), X, fixed, bad, rings, S)) return true;
   const RowMat3d saved = *S;
+  if (untangle(fs, fixed, bad, S)) return true;
+  *S = saved;
+  for (int rings : {4, 8, 16})
+    if (detail::untangle_patch(fs.patch(), X, fixed, bad, rings, S)) return true;
   if (untangle(fs, fixed, bad, S, /*soft=*/true)) return true;
   *S = saved;
   return false;
@@ -223,7 +240,7 @@ int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<ch
   fs.alive.assign(fs.F.size(), 1);
   fs.vf.resize(net.X.size());
   for (size_t f = 0; f < fs.F.size(); ++f) fs.attach(static_cast<int>(f));
-  int untangled = 0;
+  int untangled = 0, failed = 0;
   for (size_t i = net.splits.size(); i-- > 0;) {
     const auto& sp = net.splits[i];
     std::vector<int> merged;
@@ -239,11 +256,10 @@ int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<ch
     }
     if (!merged.empty()) {
       ++untangled;
-      // A face left flipped here may still be merged again below.
-      if (!untangle(fs, fixed_all, merged, S)) {
-        std::vector<int> bad = flipped_near(fs, *S, merged, 3);
-        if (!bad.empty()) untangle_fold(fs, net.X, fixed_all, bad, S);
-      }
+      // A face left flipped here may still be merged again below; but a map where folds
+      // keep failing is not going to be repaired, and each failure costs seconds: give up
+      // early so that the caller can try another network.
+      if (!untangle_fold(fs, net.X, fixed_all, merged, S) && ++failed > kMaxFailedFolds) return -1;
     }
   }
   // Whatever is still flipped at the end: untangle once more over the final faces, fold by

@@ -233,7 +233,8 @@ bool untangle_fold(const FaceSet& fs, const std::vector<Eigen::Vector3d>& X, con
 // Undoes the network's edge splits in reverse order on the map: each undo merges two pairs of
 // faces back into the input's; if a merged face flips (its quad was not convex on the
 // sphere), the neighbourhood is untangled before the next undo. Returns the number of
-// undos that needed untangling, or -1 if one could not be untangled.
+// undos that needed untangling, or -1 if a face stays flipped at the end or more than
+// kMaxFailedFolds undos could not be untangled on the way.
 int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<char>& fixed_all, RowMat3d* S) {
   FaceSet fs;
   fs.F = net.F;

@@ -71,7 +71,8 @@ Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector
 // n_f = S_a x S_b / |S_a x S_b| for ring face (v, a, b)) by projected subgradient ascent; true
 // if the point found makes every ring face positive by the exact predicate. When the kernel
 // is empty and `compromise` is given, it receives the best max-min point found (some ring
-// faces stay negative there, by as little as possible).
+// faces stay negative there, by as little as possible). `work`, if given, counts the
+// subgradient steps taken (the callers' budget).
 bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring, const Eigen::Vector3d& start,
                   Eigen::Vector3d* out, Eigen::Vector3d* compromise = nullptr, long* work = nullptr) {
   std::vector<Eigen::Vector3d> nrm;
@@ -210,14 +211,12 @@ std::vector<int> flipped_near(const FaceSet& fs, const RowMat3d& S, const std::v
 // into their kernels (untangle) repairs it fast but leaves slivers, which the stretch
 // optimizer afterwards cannot open (armadillo with 64 features: efficiency 0.07 instead of
 // 0.28); untangling the patch around it as a whole in a planar chart (detail::untangle_patch)
-// gives shapes close to the input's. So patches come first, and the soft untangling, which
-// moves corners with empty kernels to their best compromise points, comes last (on failure
-// S is restored: a soft sweep may have spread the fold).
+// gives shapes close to the input's. So small patches come first; then the vertex-by-vertex
+// untangling, enough where a small patch is boxed in by its fixed outline; then larger
+// patches; last the soft untangling, which moves corners with empty kernels to their best
+// compromise points (on failure S is restored: a soft sweep may have spread the fold).
 bool untangle_fold(const FaceSet& fs, const std::vector<Eigen::Vector3d>& X, const std::vector<char>& fixed,
                    const std::vector<int>& bad, RowMat3d* S) {
-  // Small patches first: when they succeed the fold's neighbourhood gets shapes close to the
-  // input's. The vertex-by-vertex untangling is cheap and often enough where a small patch
-  // is boxed in by its fixed outline; larger patches and the soft untangling come last.
   for (int rings : {1, 2})
     if (detail::untangle_patch(fs.patch(), X, fixed, bad, rings, S)) return true;
   const RowMat3d saved = *S;

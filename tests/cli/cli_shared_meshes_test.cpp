@@ -116,10 +116,10 @@ TEST_CASE("shared meshes: eval agrees with evalsphere.py on small shared meshes"
 // at least the reference implementation's minus 0.005. The reference figures are the
 // independent measurements in shared/docs/EVALUATION.md §4 (Praun & Hoppe's SphereParam,
 // default effort), not results of this project.
+// The check runs on one third of the manifest (entries i with i % 3 == part): three test
+// cases instead of one let ctest spread the corpus over its jobs (one took three minutes).
 namespace {
 
-// One third of the manifest (entries i with i % 3 == part): three test cases instead of one
-// let ctest spread the corpus over its jobs (one case took three minutes on its own).
 void check_param_on_shared_meshes(const std::string& meshes, int part) {
   const std::pair<const char*, double> reference[] = {
       {"knight.obj", 0.3095},   {"woody.obj", 0.9151},     {"spot.obj", 0.7182},

@@ -52,38 +52,94 @@ GltfLodPaths gltf_lod_paths(const std::string& prefix, int levels) {
   return paths;
 }
 
-Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOptions& options,
-                                 const ProgressFn& progress) {
-  const int n = image.size;
-  if (!is_geometry_image_size(n)) return Status(ErrorCode::InvalidArgument, "malformed geometry image");
-  if (options.levels < 1 || options.levels > 30 || ((n - 1) >> (options.levels - 1)) < 2)
-    return Status(ErrorCode::InvalidArgument, std::to_string(options.levels) + " levels of detail do not fit a " +
-                                                  std::to_string(n) + " x " + std::to_string(n) +
+namespace {
+
+Status check_lod_options(int size, int levels, const GltfLodOptions& options) {
+  if (!is_geometry_image_size(size)) return Status(ErrorCode::InvalidArgument, "malformed geometry image");
+  if (levels < 1 || levels > 30 || ((size - 1) >> (levels - 1)) < 2)
+    return Status(ErrorCode::InvalidArgument, std::to_string(levels) + " levels of detail do not fit a " +
+                                                  std::to_string(size) + " x " + std::to_string(size) +
                                                   " geometry image (the coarsest level needs >= 3 x 3 texels)");
   if (!(options.lod0_coverage >= 0 && options.lod0_coverage <= 1) ||
       !(options.lowest_coverage >= 0 && options.lowest_coverage <= options.lod0_coverage))
     return Status(ErrorCode::InvalidArgument, "screen coverages must satisfy 0 <= lowest_coverage <= lod0_coverage <= 1");
+  return Status();
+}
 
+int level_size(int size, int level) { return (size - 1) / (1 << level) + 1; }
+
+}  // namespace
+
+Result<std::vector<GeometryImage>> lod_geometry_images(const TriMesh& mesh, const RowMat3d& S, GeometryImage finest,
+                                                       int levels, const GeometryImageOptions& options) {
+  SPHEREKIT_RETURN_IF_ERROR(check_lod_options(finest.size, levels, GltfLodOptions{}));
+  std::vector<GeometryImage> out;
+  out.reserve(static_cast<std::size_t>(levels));
+  const int n = finest.size;
+  out.push_back(std::move(finest));
+  for (int k = 1; k < levels; ++k) {
+    SPHEREKIT_ASSIGN_OR_RETURN(GeometryImage level, sample_geometry_image(mesh, S, level_size(n, k), options));
+    out.push_back(std::move(level));
+  }
+  return out;
+}
+
+Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOptions& options,
+                                 const ProgressFn& progress) {
+  SPHEREKIT_RETURN_IF_ERROR(check_lod_options(image.size, options.levels, options));
+  std::vector<GeometryImage> levels{image};
+  for (int k = 1; k < options.levels; ++k) {
+    SPHEREKIT_ASSIGN_OR_RETURN(GeometryImage sub, subsample_geometry_image(image, level_size(image.size, k)));
+    levels.push_back(std::move(sub));
+  }
+  return build_gltf_lods(levels, options, progress);
+}
+
+Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images, const GltfLodOptions& options,
+                                 const ProgressFn& progress) {
+  if (level_images.empty()) return Status(ErrorCode::InvalidArgument, "no levels of detail");
+  const int n = level_images[0].size;
+  const int levels = static_cast<int>(level_images.size());
+  SPHEREKIT_RETURN_IF_ERROR(check_lod_options(n, levels, options));
+  for (int k = 1; k < levels; ++k)
+    if (level_images[static_cast<std::size_t>(k)].size != level_size(n, k))
+      return Status(ErrorCode::InvalidArgument, "level " + std::to_string(k) + " of detail is not " +
+                                                    std::to_string(level_size(n, k)) + " texels wide");
+
+  // Every level's primitive first: the shared quantization grid must hold all of them (fitted
+  // levels can stray a little outside the finest level's bounding box).
   GltfLods out;
-  SPHEREKIT_ASSIGN_OR_RETURN(GltfMesh finest, gltf_mesh_from_geometry_image(image));
+  std::vector<GltfMesh> meshes;
+  meshes.reserve(level_images.size());
+  for (int k = 0; k < levels; ++k) {
+    SPHEREKIT_ASSIGN_OR_RETURN(GltfMesh mesh, gltf_mesh_from_geometry_image(level_images[static_cast<std::size_t>(k)], n));
+    if (options.drop_hole_faces) mesh = gltf_mesh_without_faces(mesh, gltf_mesh_hole_faces(mesh, level_images[0]));
+    meshes.push_back(std::move(mesh));
+  }
+  GltfMesh all_points = meshes[0];
+  for (int k = 1; k < levels; ++k) {
+    const GltfMesh& m = meshes[static_cast<std::size_t>(k)];
+    const Eigen::Index rows = all_points.V.rows();
+    all_points.V.conservativeResize(rows + m.V.rows(), 3);
+    all_points.V.bottomRows(m.V.rows()) = m.V;
+    all_points.N.conservativeResize(rows + m.N.rows(), 3);
+    all_points.N.bottomRows(m.N.rows()) = m.N;
+    all_points.UV.conservativeResize(rows + m.UV.rows(), 2);
+    all_points.UV.bottomRows(m.UV.rows()) = m.UV;
+  }
+  all_points.position_index.clear();
   SPHEREKIT_ASSIGN_OR_RETURN(out.quantization,
-                             choose_draco_quantization(finest, options.reference_rms_error, options.budget));
+                             choose_draco_quantization(all_points, options.reference_rms_error, options.budget));
   DracoEncodeOptions encode;
   encode.quantization = out.quantization.quantization;
   encode.compression_level = options.compression_level;
 
-  for (int k = 0; k < options.levels; ++k) {
-    if (!report_progress(progress, "gltf", k, static_cast<double>(k) / options.levels))
+  for (int k = 0; k < levels; ++k) {
+    if (!report_progress(progress, "gltf", k, static_cast<double>(k) / levels))
       return Status(ErrorCode::Cancelled, "cancelled");
     GltfLodLevel level;
-    level.image_size = (n - 1) / (1 << k) + 1;
-    GltfMesh mesh;
-    if (k == 0) {
-      mesh = std::move(finest);
-    } else {
-      SPHEREKIT_ASSIGN_OR_RETURN(GeometryImage sub, subsample_geometry_image(image, level.image_size));
-      SPHEREKIT_ASSIGN_OR_RETURN(mesh, gltf_mesh_from_geometry_image(sub, n));
-    }
+    level.image_size = level_images[static_cast<std::size_t>(k)].size;
+    const GltfMesh& mesh = meshes[static_cast<std::size_t>(k)];
     SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(mesh, encode));
 
     detail::GlbBuilder doc;
@@ -103,13 +159,13 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
 
   // Screen coverage: halves per level (the sample spacing doubles), the last level down to
   // lowest_coverage.
-  for (int k = 0; k < options.levels; ++k)
-    out.screen_coverage.push_back(k + 1 == options.levels ? options.lowest_coverage
+  for (int k = 0; k < levels; ++k)
+    out.screen_coverage.push_back(k + 1 == levels ? options.lowest_coverage
                                                           : options.lod0_coverage / static_cast<double>(1 << k));
 
   detail::GlbBuilder doc;
   tinygltf::Value::Array ids;
-  for (int k = 0; k < options.levels; ++k) {
+  for (int k = 0; k < levels; ++k) {
     const GltfLodLevel& level = out.levels[static_cast<std::size_t>(k)];
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
                                      level_extras(k, level.image_size, n, out.quantization));
@@ -119,7 +175,7 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
     doc.model().nodes.push_back(std::move(node));
     if (k > 0) ids.push_back(detail::json_int(k));
   }
-  if (options.levels > 1) {
+  if (levels > 1) {
     // MSFT_lod on the highest level; "ids" needs at least one entry (schema minItems 1).
     tinygltf::Node& top = doc.model().nodes[0];
     tinygltf::Value::Object lod;
@@ -133,9 +189,9 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
   doc.model().scenes.emplace_back();
   doc.model().scenes[0].nodes = {0};
   doc.model().defaultScene = 0;
-  doc.model().asset.extras = asset_extras(options, n, options.levels);
+  doc.model().asset.extras = asset_extras(options, n, levels);
   SPHEREKIT_ASSIGN_OR_RETURN(out.combined_glb, doc.to_glb());
-  if (!report_progress(progress, "gltf", options.levels, 1.0)) return Status(ErrorCode::Cancelled, "cancelled");
+  if (!report_progress(progress, "gltf", levels, 1.0)) return Status(ErrorCode::Cancelled, "cancelled");
   return out;
 }
 

@@ -126,12 +126,52 @@ std::vector<std::uint8_t> gltf_mesh_hole_faces(const GltfMesh& mesh, const Geome
     return static_cast<int>(std::clamp(std::lround(x * T - 0.5), 0L, static_cast<long>(T - 1)));
   };
   out.resize(static_cast<std::size_t>(mesh.F.rows()), 0);
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f) {
+    int corners = 0;  // in a hole; the rule of geometry_image_hole_faces: two or three
     for (int k = 0; k < 3; ++k) {
       const Eigen::Index p = mesh.F(f, k);
       if (p < 0 || p >= mesh.UV.rows()) continue;
       const int i = texel(mesh.UV(p, 1)), j = texel(mesh.UV(p, 0));
-      if (image.in_hole[static_cast<std::size_t>(i) * T + j]) out[static_cast<std::size_t>(f)] = 1;
+      corners += image.in_hole[static_cast<std::size_t>(i) * T + j] != 0;
+    }
+    out[static_cast<std::size_t>(f)] = corners >= 2 ? 1 : 0;
+  }
+  return out;
+}
+
+GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::uint8_t>& drop) {
+  if (drop.size() != static_cast<std::size_t>(mesh.F.rows()) || !check_gltf_mesh(mesh).ok()) return mesh;
+  std::vector<std::int32_t> new_index(static_cast<std::size_t>(mesh.V.rows()), -1);
+  Eigen::Index faces = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    if (!drop[static_cast<std::size_t>(f)]) {
+      ++faces;
+      for (int k = 0; k < 3; ++k) new_index[static_cast<std::size_t>(mesh.F(f, k))] = 0;
+    }
+  std::int32_t points = 0;
+  for (auto& i : new_index)
+    if (i == 0) i = points++;
+  GltfMesh out;
+  out.texture_size = mesh.texture_size;
+  out.V.resize(points, 3);
+  if (mesh.N.rows() > 0) out.N.resize(points, 3);
+  if (mesh.UV.rows() > 0) out.UV.resize(points, 2);
+  if (!mesh.position_index.empty()) out.position_index.resize(static_cast<std::size_t>(points));
+  for (Eigen::Index p = 0; p < mesh.V.rows(); ++p) {
+    const std::int32_t q = new_index[static_cast<std::size_t>(p)];
+    if (q < 0) continue;
+    out.V.row(q) = mesh.V.row(p);
+    if (mesh.N.rows() > 0) out.N.row(q) = mesh.N.row(p);
+    if (mesh.UV.rows() > 0) out.UV.row(q) = mesh.UV.row(p);
+    if (!mesh.position_index.empty())
+      out.position_index[static_cast<std::size_t>(q)] = mesh.position_index[static_cast<std::size_t>(p)];
+  }
+  out.F.resize(faces, 3);
+  Eigen::Index row = 0;
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    if (!drop[static_cast<std::size_t>(f)]) {
+      for (int k = 0; k < 3; ++k) out.F(row, k) = new_index[static_cast<std::size_t>(mesh.F(f, k))];
+      ++row;
     }
   return out;
 }

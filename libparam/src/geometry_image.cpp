@@ -209,17 +209,23 @@ std::vector<std::uint8_t> geometry_image_hole_faces(const GeometryImage& image) 
   if (!is_geometry_image_size(n) || image.in_hole.size() != static_cast<std::size_t>(n) * n) return out;
   const int m = n - 1, half = m / 2;
   out.reserve(2 * static_cast<std::size_t>(m) * m);
-  const auto hole = [&](int i, int j) { return image.in_hole[static_cast<std::size_t>(i) * n + j] != 0; };
+  const auto hole = [&](int i, int j) { return image.in_hole[static_cast<std::size_t>(i) * n + j] != 0 ? 1 : 0; };
+  // A face is in a hole when most of it is: two or three of its corners (a discrete "its
+  // centre lies in the hole"). Faces with one hole corner reach from the surface to the rim
+  // (where hole texels sit) and are the remesh's only cover of the band along the rim;
+  // leaving them out too would leave that band uncovered (bunny at 257: 79.9 instead of
+  // 82.7 dB, the loss all in the original-to-remesh direction).
+  const auto most = [](int a, int b, int c) -> std::uint8_t { return a + b + c >= 2 ? 1 : 0; };
   // Same cell order and split as geometry_image_mesh.
   for (int i = 0; i < m; ++i)
     for (int j = 0; j < m; ++j) {
-      const bool A = hole(i, j), B = hole(i, j + 1), C = hole(i + 1, j + 1), D = hole(i + 1, j);
+      const int A = hole(i, j), B = hole(i, j + 1), C = hole(i + 1, j + 1), D = hole(i + 1, j);
       if ((j >= half) == (i >= half)) {
-        out.push_back(A || B || D);
-        out.push_back(B || C || D);
+        out.push_back(most(A, B, D));
+        out.push_back(most(B, C, D));
       } else {
-        out.push_back(A || B || C);
-        out.push_back(A || C || D);
+        out.push_back(most(A, B, C));
+        out.push_back(most(A, C, D));
       }
     }
   return out;

@@ -336,3 +336,41 @@ TEST_CASE("hole faces of a glTF primitive are found through its texture coordina
   // A primitive without texture coordinates has no texels to ask about.
   CHECK(gltf_mesh_hole_faces(gltf_mesh_from_trimesh(holed).value(), gi.value()).empty());
 }
+
+TEST_CASE("a primitive without some faces keeps the rest in order and drops unused points", "[convert]") {
+  const GeometryImage gi = test::blob_geometry_image(9);
+  auto full = gltf_mesh_from_geometry_image(gi);
+  REQUIRE(full.ok());
+  const GltfMesh& m = full.value();
+  // Drop every face touching point 40 (the image's centre texel, (4, 4), an octahedron
+  // vertex): that point goes, no other does (each neighbour keeps a face elsewhere).
+  std::vector<std::uint8_t> drop(static_cast<std::size_t>(m.F.rows()), 0);
+  int dropped = 0;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    if (m.F(f, 0) == 40 || m.F(f, 1) == 40 || m.F(f, 2) == 40) drop[static_cast<std::size_t>(f)] = 1, ++dropped;
+  REQUIRE(dropped == 4);  // the octahedron's vertices have valence 4
+  const GltfMesh out = gltf_mesh_without_faces(m, drop);
+  REQUIRE(out.V.rows() == m.V.rows() - 1);
+  REQUIRE(out.F.rows() == m.F.rows() - dropped);
+  CHECK(out.N.rows() == out.V.rows());
+  CHECK(out.UV.rows() == out.V.rows());
+  CHECK(out.position_index.size() == static_cast<std::size_t>(out.V.rows()));
+  CHECK(out.texture_size == m.texture_size);
+  CHECK(check_gltf_mesh(out).ok());
+  // Points after 40 move down by one; faces keep their order and their corners' data.
+  Eigen::Index row = 0;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    if (drop[static_cast<std::size_t>(f)]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Index p = m.F(f, k), q = out.F(row, k);
+      REQUIRE(q == (p < 40 ? p : p - 1));
+      REQUIRE(out.V.row(q) == m.V.row(p));
+      REQUIRE(out.UV.row(q) == m.UV.row(p));
+      REQUIRE(out.position_index[static_cast<std::size_t>(q)] == m.position_index[static_cast<std::size_t>(p)]);
+    }
+    ++row;
+  }
+  // No flags, or flags of the wrong count: unchanged.
+  CHECK(gltf_mesh_without_faces(m, {}).F == m.F);
+  CHECK(gltf_mesh_without_faces(m, std::vector<std::uint8_t>(3, 1)).V == m.V);
+}

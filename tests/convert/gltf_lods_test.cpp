@@ -3,6 +3,7 @@
 // the geometry image it came from; the MSFT_lod structure of the combined file.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -12,6 +13,7 @@
 #include "cli_runner.h"
 #include "gltf_test_support.h"
 #include "spherekit/convert/gltf_lods.h"
+#include "test_meshes.h"
 #include "test_paths.h"
 
 namespace fs = std::filesystem;
@@ -145,6 +147,78 @@ TEST_CASE("glTF LODs: a collection gets one point order per level", "[convert]")
     CHECK(da.UV == db.UV);
     CHECK(da.F == db.F);
   }
+}
+
+TEST_CASE("glTF LODs of a mesh with holes: each level fitted at its size, hole faces left out", "[convert]") {
+  // Holes a vertex's ring of a level-2 icosphere wide: several texels even at 17 x 17.
+  const TriMesh holed = test::sphere_with_holes(2, 3);
+  const RowMat3d S = holed.V.rowwise().normalized();
+  GeometryImageOptions fit;
+  fit.fit_positions = true;
+  auto fine = sample_geometry_image(holed, S, 65, fit);
+  REQUIRE(fine.ok());
+  REQUIRE(fine->texels_in_holes > 0);
+  auto levels = lod_geometry_images(holed, S, fine.value(), 3, fit);
+  REQUIRE(levels.ok());
+  REQUIRE(levels->size() == 3);
+  RemeshErrorOptions err;
+  err.samples = 50000;
+  for (std::size_t k = 0; k < 3; ++k) {
+    INFO("level " << k);
+    const GeometryImage& level = (*levels)[k];
+    const int n = (65 - 1) / (1 << k) + 1;
+    REQUIRE(level.size == n);
+    auto sub = subsample_geometry_image(fine.value(), n);
+    REQUIRE(sub.ok());
+    // Same domain points: same hole flags, normals and faces as the finest image's texels.
+    CHECK(level.in_hole == sub->in_hole);
+    CHECK(level.face_ids == sub->face_ids);
+    if (k == 0) {
+      CHECK(level.positions == fine->positions);
+      continue;
+    }
+    // Fitted at its own size, the level is closer to the mesh than the subsampled finest image.
+    const double own = remesh_psnr(holed, geometry_image_mesh(level), err, geometry_image_hole_faces(level));
+    const double subsampled = remesh_psnr(holed, geometry_image_mesh(sub.value()), err, geometry_image_hole_faces(sub.value()));
+    CAPTURE(own, subsampled);
+    CHECK(own > subsampled);
+  }
+
+  GltfLodOptions options = test::lod_test_options();
+  auto kept = build_gltf_lods(levels.value(), options);
+  options.drop_hole_faces = true;
+  auto dropped = build_gltf_lods(levels.value(), options);
+  REQUIRE(kept.ok());
+  REQUIRE(dropped.ok());
+  int some_dropped = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    INFO("level " << k);
+    const GeometryImage& level = (*levels)[k];
+    const int n = level.size;
+    const auto flags = geometry_image_hole_faces(level);
+    const auto holes = std::count(flags.begin(), flags.end(), 1);
+    some_dropped += holes > 0;
+    const GltfMesh& all = kept->levels[k].primitive.decoded.mesh;
+    const GltfMesh& open = dropped->levels[k].primitive.decoded.mesh;
+    CHECK(all.F.rows() == 2 * (n - 1) * (n - 1));
+    CHECK(open.F.rows() == all.F.rows() - holes);
+    // No face left spans a hole, and every point left is used by a face.
+    const auto left = gltf_mesh_hole_faces(open, fine.value());
+    CHECK(std::count(left.begin(), left.end(), 1) == 0);
+    std::vector<int> used(static_cast<std::size_t>(open.V.rows()), 0);
+    for (Eigen::Index f = 0; f < open.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) used[static_cast<std::size_t>(open.F(f, c))] = 1;
+    CHECK(std::count(used.begin(), used.end(), 0) == 0);
+    CHECK(open.V.rows() < all.V.rows());
+    CHECK(dropped->levels[k].glb.size() < kept->levels[k].glb.size());
+  }
+  CHECK(some_dropped == 3);
+
+  // Levels of the wrong size are refused.
+  std::vector<GeometryImage> wrong{fine.value(), fine.value()};
+  CHECK(build_gltf_lods(wrong, options).status().code() == ErrorCode::InvalidArgument);
+  CHECK(build_gltf_lods(std::vector<GeometryImage>{}, options).status().code() == ErrorCode::InvalidArgument);
+  CHECK(lod_geometry_images(holed, S, fine.value(), 7, fit).status().code() == ErrorCode::InvalidArgument);
 }
 
 TEST_CASE("glTF LODs: errors and cancellation", "[convert]") {

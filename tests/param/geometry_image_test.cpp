@@ -440,6 +440,35 @@ TEST_CASE("fitted geometry image of the octahedron reproduces it (the grid repre
   }
 }
 
+TEST_CASE("hole faces: a face is in a hole when two or three of its texels are", "[gim]") {
+  // A 5 x 5 image (4 x 4 cells; quadrant i, j < 2 splits along the anti-diagonal: faces ABD,
+  // BCD of cell (i, j) with A (i,j), B (i,j+1), C (i+1,j+1), D (i+1,j)).
+  GeometryImage gi;
+  gi.size = 5;
+  gi.positions.assign(5 * 5 * 3, 0.0f);
+  gi.in_hole.assign(25, 0);
+  const auto face = [](int i, int j, int second) { return static_cast<std::size_t>(2 * (i * 4 + j) + second); };
+  // One hole texel: no face is in the hole.
+  gi.in_hole[1 * 5 + 1] = 1;
+  auto flags = geometry_image_hole_faces(gi);
+  REQUIRE(flags.size() == 32);
+  CHECK(std::count(flags.begin(), flags.end(), 1) == 0);
+  // Texels (1,1) and (1,2): the faces holding both, and only those.
+  gi.in_hole[1 * 5 + 2] = 1;
+  flags = geometry_image_hole_faces(gi);
+  CHECK(std::count(flags.begin(), flags.end(), 1) == 2);
+  CHECK(flags[face(1, 1, 0)] == 1);  // A (1,1), B (1,2), D (2,1)
+  CHECK(flags[face(0, 1, 1)] == 1);  // B (0,2), C (1,2), D (1,1)
+  // All three texels of face ABD of cell (1, 1): it, and the faces holding two of them.
+  gi.in_hole[2 * 5 + 1] = 1;
+  flags = geometry_image_hole_faces(gi);
+  CHECK(flags[face(1, 1, 0)] == 1);
+  CHECK(flags[face(1, 1, 1)] == 1);  // B (1,2), C (2,2), D (2,1)
+  CHECK(flags[face(0, 1, 1)] == 1);
+  CHECK(flags[face(1, 0, 1)] == 1);  // B (1,1), C (2,1), D (2,0)
+  CHECK(std::count(flags.begin(), flags.end(), 1) == 4);
+}
+
 TEST_CASE("fitted geometry image: a mesh with holes keeps its hole texels and gets no worse", "[gim]") {
   const TriMesh m = test::sphere_with_holes(4, 3);
   GeometryImageOptions fit;
@@ -451,6 +480,14 @@ TEST_CASE("fitted geometry image: a mesh with holes keeps its hole texels and ge
   REQUIRE(a.value().texels_in_holes > 0);
   CHECK(a.value().in_hole == b.value().in_hole);
   for (float x : b.value().positions) REQUIRE(std::isfinite(x));
+  // Hole texels are held exactly where the sampler put them (on the rims); the others move.
+  int moved = 0;
+  for (std::size_t t = 0; t < a.value().in_hole.size(); ++t) {
+    const bool same = std::equal(&a.value().positions[3 * t], &a.value().positions[3 * t + 3], &b.value().positions[3 * t]);
+    if (a.value().in_hole[t]) REQUIRE(same);
+    else moved += same ? 0 : 1;
+  }
+  CHECK(moved > static_cast<int>(a.value().in_hole.size()) / 2);
   RemeshErrorOptions opts;
   opts.samples = 100000;
   const double pa = remesh_psnr(m, geometry_image_mesh(a.value()), opts, geometry_image_hole_faces(a.value()));

@@ -237,8 +237,12 @@ int run_convert(const ConvertArgs& a) {
     opts.reference_rms_error = a.psnr_samples > 0 ? err.rms : 0;
     opts.name = file_stem(a.mesh);
     opts.provenance = {a.mesh, a.sphere};
+    // A single mesh's levels show its holes; each level is fitted at its own size.
+    opts.drop_hole_faces = true;
+    auto level_images = convert::lod_geometry_images(m.mesh, map->S, image, a.lods, geometry_image_options(a));
+    if (!level_images.ok()) return print_error(with_file(level_images.status(), a.mesh));
     ProgressRenderer progress(a.quiet, file_stem(a.mesh));
-    auto built = convert::build_gltf_lods(image, opts, progress.callback());
+    auto built = convert::build_gltf_lods(level_images.value(), opts, progress.callback());
     progress.finish();
     if (!built.ok()) return print_error(built.status());
     lods = std::move(built).value();
@@ -403,9 +407,11 @@ void register_convert(CLI::App& app) {
       "with --remesh the triangle mesh the image defines, and two PNG previews of the image,\n"
       "OUT_normals.png (normals as colours) and OUT_positions.png (positions in the bounding\n"
       "box as colours; texels in holes of the mesh at half brightness). Prints the remesh PSNR against the\n"
-      "original (peak = bounding-box diagonal, symmetric RMS surface distance); --report writes\n"
+      "original (peak = bounding-box diagonal, symmetric RMS surface distance; for a mesh with\n"
+      "holes without the remesh faces that have two or three texels in a hole); --report writes\n"
       "it with the timings as JSON. With --lods L it also writes L levels of detail (image sizes\n"
-      "N, (N-1)/2+1, ...) as Draco-compressed glTF (POSITION, NORMAL, TEXCOORD_0 = texel centres\n"
+      "N, (N-1)/2+1, ..., each resampled and fitted at its own size; faces spanning holes of the\n"
+      "mesh left out) as Draco-compressed glTF (POSITION, NORMAL, TEXCOORD_0 = texel centres\n"
       "of the image): OUT_lod0.glb ... one per level, and OUT_lods.glb with all of them (MSFT_lod,\n"
       "level 0 shown by viewers without it), OUT being -o without its extension. Position bits:\n"
       "the fewest >= --min-position-bits whose quantization error is at most a tenth of the\n"

@@ -140,7 +140,10 @@ MeshOutcome run_one(const RunArgs& a, const std::string& path, const std::string
   lod_opts.reference_rms_error = err.rms;
   lod_opts.name = name;
   lod_opts.provenance = {path, sphere_path};
-  auto lods = convert::build_gltf_lods(image, lod_opts);
+  lod_opts.drop_hole_faces = true;
+  auto level_images = convert::lod_geometry_images(m.mesh, r.map.S, image, kGeometryImageLods, gio);
+  if (!level_images.ok()) return fail(with_file(level_images.status(), path));
+  auto lods = convert::build_gltf_lods(level_images.value(), lod_opts);
   if (!lods.ok()) return fail(lods.status());
   auto lod_paths = convert::write_gltf_lods(gim_prefix, lods.value());
   if (!lod_paths.ok()) return fail(lod_paths.status());

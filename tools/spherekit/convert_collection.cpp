@@ -106,7 +106,10 @@ int run_convert_collection(const ConvertArgs& a) {
         opts.reference_rms_error = a.psnr_samples > 0 ? out.error.rms : 0;
         opts.name = m.name;
         opts.provenance = {m.source, info->dir};
-        auto built = convert::build_gltf_lods(out.image, opts);
+        // Hole faces stay: every member's levels share one connectivity.
+        auto level_images = convert::lod_geometry_images(m.mesh, m.map.S, out.image, a.lods, geometry_image_options(a));
+        if (!level_images.ok()) return with_file(level_images.status(), m.source);
+        auto built = convert::build_gltf_lods(level_images.value(), opts);
         if (!built.ok()) return built.status();
         auto paths = convert::write_gltf_lods((fs::path(dir) / m.name).string(), built.value());
         if (!paths.ok()) return paths.status();

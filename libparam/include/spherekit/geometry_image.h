@@ -179,10 +179,11 @@ RowMat3i geometry_image_grid_faces(int n);
 /// a closed genus-0 manifold with 2(N-1)^2 faces. An empty/invalid image gives an empty mesh.
 TriMesh geometry_image_mesh(const GeometryImage& image);
 
-/// Per face of geometry_image_mesh(image) (same order): 1 if any of its three texels is in a
-/// hole. Such faces span (part of) a hole of the source mesh: hole texels sit at the nearest
-/// point of the nearest face, on or near the hole's rim, so these faces keep the remesh closed
-/// but are not resampled surface. Empty if image.in_hole is.
+/// Per face of geometry_image_mesh(image) (same order): 1 if at least two of its three texels
+/// are in a hole. Such faces span (part of) a hole of the source mesh: hole texels sit at the
+/// nearest point of the nearest face, on the hole's rim, so these faces keep the remesh closed
+/// but are not resampled surface. Faces with a single hole texel are kept: they reach from
+/// the surface to the rim and cover the band along it. Empty if image.in_hole is.
 std::vector<std::uint8_t> geometry_image_hole_faces(const GeometryImage& image);
 
 // ---------------------------------------------------------------------------------------

@@ -1,15 +1,21 @@
 // Levels of detail of a geometry image as Draco-compressed binary glTF: one .glb per level, and
 // one .glb holding every level with MSFT_lod.
 //
-// Levels. Level k is the geometry image subsampled to (N-1)/2^k + 1 texels per side (257, 129,
-// 65, 33, ...): the octahedral lattices nest, so each level is the remesh the image of that
-// size defines (geometry_image_mesh), with the texture coordinates of the full image
-// (gltf_mesh.h), so one texture or normal map made from the image serves every level.
+// Levels. Level k is a geometry image of (N-1)/2^k + 1 texels per side (257, 129, 65, 33, ...):
+// the octahedral lattices nest, so each level is the remesh the image of that size defines
+// (geometry_image_mesh), with the texture coordinates of the full image (gltf_mesh.h), so one
+// texture or normal map made from the image serves every level. The levels are either given
+// (lod_geometry_images: each level's positions fitted to the mesh at its own size, 3-5 dB
+// better than the finest image subsampled) or the finest image subsampled.
+//
+// Holes. For a mesh with holes, drop_hole_faces leaves out the faces that span a hole
+// (gltf_mesh_hole_faces) and the points only they use, so a viewer shows the holes. A
+// collection keeps them: its members must share one connectivity.
 //
 // Per primitive: POSITION, NORMAL, TEXCOORD_0 in a KHR_draco_mesh_compression bitstream, no
 // uncompressed fallback (the extension is required), accessors written from the decoded data
-// (gltf_draco.h). All levels share one position grid (that of level 0), so a texel present in
-// several levels decodes to the same position in each.
+// (gltf_draco.h). All levels share one position grid (the bounding cube of every level's
+// positions).
 //
 // The combined file (MSFT_lod README, KhronosGroup/glTF extensions/2.0/Vendor/MSFT_lod):
 //   scene 0 -> node 0 "NAME_LOD0" (mesh 0) with
@@ -54,6 +60,9 @@ struct GltfLodOptions {
   double reference_rms_error = 0;
   double lod0_coverage = 0.5;   ///< MSFT_screencoverage of level 0 (coverage where level 1 takes over)
   double lowest_coverage = 0;   ///< MSFT_screencoverage of the last level (0: never culled)
+  /// Leave out the faces spanning holes of the mesh (and the points only they use). Changes
+  /// the connectivity from member to member of a collection, so collections keep them.
+  bool drop_hole_faces = false;
   std::string name = "mesh";    ///< node and mesh names: NAME_LOD0, NAME_LOD1, ...
   GltfProvenance provenance;
   // Effort
@@ -81,6 +90,20 @@ struct GltfLods {
 /// tinygltf failed), Cancelled.
 [[nodiscard]] Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOptions& options = {},
                                                const ProgressFn& progress = {});
+/// The same with the level images given: `level_images[k]` has (N-1)/2^k + 1 texels per side,
+/// N = level_images[0].size, one image per level (options.levels is ignored). Errors as above,
+/// and InvalidArgument if a level has the wrong size.
+[[nodiscard]] Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
+                                               const GltfLodOptions& options = {}, const ProgressFn& progress = {});
+
+/// The images of `levels` levels of detail of `mesh` through its sphere map `S`: level 0 is
+/// `finest` (moved in), level k is sampled at (N-1)/2^k + 1 with `options` (so with
+/// options.fit_positions each level's positions are fitted at its own size; hole flags, normals
+/// and face ids equal the finest image's at the shared texels, the domain points being
+/// bit-identical). Errors: those of sample_geometry_image, InvalidArgument (levels do not fit).
+[[nodiscard]] Result<std::vector<GeometryImage>> lod_geometry_images(const TriMesh& mesh, const RowMat3d& S,
+                                                                     GeometryImage finest, int levels,
+                                                                     const GeometryImageOptions& options);
 
 /// The file names write_gltf_lods uses: PREFIX_lod0.glb ... PREFIX_lod{L-1}.glb, PREFIX_lods.glb.
 struct GltfLodPaths {

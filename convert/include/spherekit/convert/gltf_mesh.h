@@ -78,10 +78,17 @@ struct GltfMesh {
 [[nodiscard]] Result<GltfMesh> gltf_mesh_from_geometry_image(const GeometryImage& image, int texture_size = 0);
 
 /// Per face of `mesh`, a primitive made from `image` or from a subsampling of it (also after a
-/// Draco round trip, which reorders points and faces): 1 if the texel of any of its corners,
-/// found from the corner's texture coordinate, lies in a hole (as geometry_image_hole_faces).
+/// Draco round trip, which reorders points and faces): 1 if the texels of two or three of its
+/// corners, found from the corners' texture coordinates, lie in a hole (the rule of
+/// geometry_image_hole_faces).
 /// Empty if image.in_hole is empty or the mesh has no texture coordinates.
 std::vector<std::uint8_t> gltf_mesh_hole_faces(const GltfMesh& mesh, const GeometryImage& image);
+
+/// `mesh` without the faces flagged 1 in `drop` (one flag per face, or empty: none) and
+/// without the points no remaining face uses; the remaining points and faces keep their order
+/// and attributes (position_index and texture_size too). A mesh check_gltf_mesh refuses, or
+/// flags of the wrong count, give `mesh` unchanged.
+GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::uint8_t>& drop);
 
 /// A triangle mesh as a primitive without texture coordinates: points = vertices, normals =
 /// area-weighted face normals summed per vertex and normalized (a vertex with no non-degenerate

@@ -113,7 +113,9 @@ Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
   meshes.reserve(level_images.size());
   for (int k = 0; k < levels; ++k) {
     SPHEREKIT_ASSIGN_OR_RETURN(GltfMesh mesh, gltf_mesh_from_geometry_image(level_images[static_cast<std::size_t>(k)], n));
-    if (options.drop_hole_faces) mesh = gltf_mesh_without_faces(mesh, gltf_mesh_hole_faces(mesh, level_images[0]));
+    // Before encoding the faces are geometry_image_mesh's, in its order.
+    if (options.drop_hole_faces)
+      mesh = gltf_mesh_without_faces(mesh, geometry_image_hole_faces(level_images[static_cast<std::size_t>(k)]));
     meshes.push_back(std::move(mesh));
   }
   GltfMesh all_points = meshes[0];

@@ -207,28 +207,89 @@ std::vector<std::uint8_t> geometry_image_hole_faces(const GeometryImage& image) 
   const int n = image.size;
   std::vector<std::uint8_t> out;
   if (!is_geometry_image_size(n) || image.in_hole.size() != static_cast<std::size_t>(n) * n) return out;
-  const int m = n - 1, half = m / 2;
-  out.reserve(2 * static_cast<std::size_t>(m) * m);
-  const auto hole = [&](int i, int j) { return image.in_hole[static_cast<std::size_t>(i) * n + j] != 0 ? 1 : 0; };
   // A face is in a hole when most of it is: two or three of its corners (a discrete "its
   // centre lies in the hole"). Faces with one hole corner reach from the surface to the rim
   // (where hole texels sit) and are the remesh's only cover of the band along the rim;
   // leaving them out too would leave that band uncovered (bunny at 257: 79.9 instead of
   // 82.7 dB, the loss all in the original-to-remesh direction).
-  const auto most = [](int a, int b, int c) -> std::uint8_t { return a + b + c >= 2 ? 1 : 0; };
-  // Same cell order and split as geometry_image_mesh.
-  for (int i = 0; i < m; ++i)
-    for (int j = 0; j < m; ++j) {
-      const int A = hole(i, j), B = hole(i, j + 1), C = hole(i + 1, j + 1), D = hole(i + 1, j);
-      if ((j >= half) == (i >= half)) {
-        out.push_back(most(A, B, D));
-        out.push_back(most(B, C, D));
-      } else {
-        out.push_back(most(A, B, C));
-        out.push_back(most(A, C, D));
-      }
+  const RowMat3i grid = geometry_image_grid_faces(n);  // geometry_image_mesh's face order
+  const auto faces = static_cast<std::size_t>(grid.rows());
+  out.assign(faces, 0);
+  bool any = false;
+  for (std::size_t f = 0; f < faces; ++f) {
+    int corners = 0;
+    for (int k = 0; k < 3; ++k) corners += image.in_hole[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))] != 0;
+    out[f] = corners >= 2 ? 1 : 0;
+    any = any || out[f];
+  }
+  if (!any) return out;
+
+  // The faces left must stay a manifold: where two holes (or two arms of one) meet at a
+  // vertex, their kept faces would form two fans joined only there. Such a vertex has more
+  // than two boundary edges; its hole faces are kept until no vertex has (the set of kept
+  // faces only grows, so this ends).
+  int vertices = 0;
+  const std::vector<int> id = geometry_image_welded_ids(n, &vertices);
+  const auto nv = static_cast<std::uint64_t>(vertices);
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> half_edges;  // (edge key, face)
+  half_edges.reserve(3 * faces);
+  for (std::size_t f = 0; f < faces; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::uint64_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))]);
+      const auto b = static_cast<std::uint64_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), (k + 1) % 3))]);
+      half_edges.emplace_back(std::min(a, b) * nv + std::max(a, b), static_cast<std::uint32_t>(f));
     }
-  return out;
+  std::sort(half_edges.begin(), half_edges.end());
+  std::vector<int> boundary(static_cast<std::size_t>(vertices));
+  std::vector<std::uint8_t> pinched(static_cast<std::size_t>(vertices));
+  for (;;) {
+    std::fill(boundary.begin(), boundary.end(), 0);
+    // The welded grid is closed: every edge has exactly two faces, adjacent after sorting.
+    for (std::size_t e = 0; e + 1 < half_edges.size(); e += 2)
+      if (out[half_edges[e].second] != out[half_edges[e + 1].second]) {
+        ++boundary[static_cast<std::size_t>(half_edges[e].first / nv)];
+        ++boundary[static_cast<std::size_t>(half_edges[e].first % nv)];
+      }
+    bool found = false;
+    for (std::size_t v = 0; v < boundary.size(); ++v) {
+      pinched[v] = boundary[v] > 2 ? 1 : 0;
+      found = found || pinched[v];
+    }
+    if (!found) return out;
+    for (std::size_t f = 0; f < faces; ++f)
+      for (int k = 0; k < 3 && out[f]; ++k)
+        if (pinched[static_cast<std::size_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))])]) out[f] = 0;
+  }
+}
+
+TriMesh geometry_image_open_mesh(const GeometryImage& image) {
+  TriMesh closed = geometry_image_mesh(image);
+  const std::vector<std::uint8_t> drop = geometry_image_hole_faces(image);
+  if (drop.size() != static_cast<std::size_t>(closed.F.rows()) ||
+      std::find(drop.begin(), drop.end(), 1) == drop.end())
+    return closed;
+  std::vector<int> new_index(static_cast<std::size_t>(closed.V.rows()), -1);
+  Eigen::Index faces = 0;
+  for (Eigen::Index f = 0; f < closed.F.rows(); ++f)
+    if (!drop[static_cast<std::size_t>(f)]) {
+      ++faces;
+      for (int k = 0; k < 3; ++k) new_index[static_cast<std::size_t>(closed.F(f, k))] = 0;
+    }
+  int vertices = 0;
+  for (int& i : new_index)
+    if (i == 0) i = vertices++;
+  TriMesh open;
+  open.V.resize(vertices, 3);
+  for (Eigen::Index v = 0; v < closed.V.rows(); ++v)
+    if (const int i = new_index[static_cast<std::size_t>(v)]; i >= 0) open.V.row(i) = closed.V.row(v);
+  open.F.resize(faces, 3);
+  Eigen::Index row = 0;
+  for (Eigen::Index f = 0; f < closed.F.rows(); ++f) {
+    if (drop[static_cast<std::size_t>(f)]) continue;
+    for (int k = 0; k < 3; ++k) open.F(row, k) = new_index[static_cast<std::size_t>(closed.F(f, k))];
+    ++row;
+  }
+  return open;
 }
 
 // ---------------------------------------------------------------------------------------

@@ -361,7 +361,7 @@ TEST_CASE("param checks every output folder before writing anything", "[cli]") {
   CHECK(files_in(out_dir).empty());
 }
 
-TEST_CASE("param on a mesh with holes maps the original vertices only", "[cli]") {
+TEST_CASE("param on a mesh with holes maps the original vertices only; convert leaves the holes open", "[cli]") {
   const std::string dir = spherekit::test::temp_dir("cli_param_holes");
   const TriMesh holes = spherekit::test::sphere_with_holes(2, 2);
   const std::string mesh = write_obj(dir, "holes.obj", holes);
@@ -383,6 +383,21 @@ TEST_CASE("param on a mesh with holes maps the original vertices only", "[cli]")
   CHECK(m["flipped"] == 0);
   CHECK(m["flipped_exact"] == 0);
   CHECK_FALSE(m.contains("winding"));
+
+  // The remesh of one mesh keeps its holes open and is a genus-0 manifold with both rims.
+  const std::string remesh = dir + "/holes.gim.obj";
+  CliRun c = run_cli("convert " + quote(mesh) + " " + quote(sphere) + " -o " + quote(dir + "/holes.exr") +
+                         " --size 33 --psnr-samples 0 --quiet --remesh " + quote(remesh),
+                     dir);
+  INFO("convert stderr: " << c.err);
+  REQUIRE(c.exit_code == 0);
+  CliRun k = run_cli("check --json " + quote(remesh), dir);
+  INFO("check: " << k.out);
+  REQUIRE(k.exit_code == 0);
+  json r = parse_json(k.out).at(0);
+  CHECK(r["genus0_ok"] == true);
+  CHECK(r["boundary_loops"] == 2);
+  CHECK(r["unreferenced_vertices"] == 0);
 }
 
 TEST_CASE("samples writes meshes and landmarks that check accepts", "[cli]") {

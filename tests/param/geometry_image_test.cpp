@@ -364,11 +364,29 @@ TEST_CASE("geometry image of a mesh with holes: hole texels and hole faces", "[g
   const double all = remesh_psnr(m, rm, opts), kept = remesh_psnr(m, rm, opts, hole_faces);
   CAPTURE(all, kept);
   CHECK(kept > all);
+  // The open remesh: the kept faces, in order, on the same positions, and no unused vertex.
+  const TriMesh open = geometry_image_open_mesh(gi);
+  REQUIRE(open.F.rows() == rm.F.rows() - excluded);
+  std::vector<int> used(static_cast<std::size_t>(open.V.rows()), 0);
+  Eigen::Index row = 0;
+  for (Eigen::Index f = 0; f < rm.F.rows(); ++f) {
+    if (hole_faces[static_cast<std::size_t>(f)]) continue;
+    for (int c = 0; c < 3; ++c) {
+      REQUIRE(open.V.row(open.F(row, c)) == rm.V.row(rm.F(f, c)));
+      used[static_cast<std::size_t>(open.F(row, c))] = 1;
+    }
+    ++row;
+  }
+  CHECK(std::count(used.begin(), used.end(), 0) == 0);
+  CHECK(open.V.rows() < rm.V.rows());
   // Closed meshes have no hole faces.
   const TriMesh ico = test::icosphere(2);
   auto r2 = sample_geometry_image(ico, radial(ico), 17);
   REQUIRE(r2.ok());
   for (auto h : geometry_image_hole_faces(r2.value())) REQUIRE(h == 0);
+  const TriMesh closed = geometry_image_mesh(r2.value()), same = geometry_image_open_mesh(r2.value());
+  CHECK(same.V == closed.V);
+  CHECK(same.F == closed.F);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -467,6 +485,45 @@ TEST_CASE("hole faces: a face is in a hole when two or three of its texels are",
   CHECK(flags[face(0, 1, 1)] == 1);
   CHECK(flags[face(1, 0, 1)] == 1);  // B (1,1), C (2,1), D (2,0)
   CHECK(std::count(flags.begin(), flags.end(), 1) == 4);
+}
+
+TEST_CASE("hole faces leave a manifold: no vertex where kept faces meet in two fans", "[gim]") {
+  // Random hole texels (a third of them; fold pairs alike) make many places where the
+  // majority rule alone would leave two fans of kept faces joined at one vertex.
+  const int n = 17;
+  int count = 0;
+  const std::vector<int> id = geometry_image_welded_ids(n, &count);
+  const RowMat3i grid = geometry_image_grid_faces(n);
+  std::mt19937 rng(5);
+  int repaired = 0;
+  for (int round = 0; round < 20; ++round) {
+    GeometryImage gi;
+    gi.size = n;
+    gi.positions.assign(static_cast<std::size_t>(n) * n * 3, 0.0f);
+    gi.in_hole.assign(static_cast<std::size_t>(n) * n, 0);
+    std::vector<std::uint8_t> welded_hole(static_cast<std::size_t>(count));
+    for (auto& h : welded_hole) h = rng() % 3 == 0 ? 1 : 0;
+    for (std::size_t t = 0; t < gi.in_hole.size(); ++t) gi.in_hole[t] = welded_hole[static_cast<std::size_t>(id[t])];
+    const auto flags = geometry_image_hole_faces(gi);
+    REQUIRE(flags.size() == static_cast<std::size_t>(grid.rows()));
+    std::map<std::pair<int, int>, int> kept_on_edge;  // welded edge -> kept faces on it
+    for (Eigen::Index f = 0; f < grid.rows(); ++f) {
+      int corners = 0;
+      for (int k = 0; k < 3; ++k) corners += gi.in_hole[static_cast<std::size_t>(grid(f, k))];
+      // Only faces with two or three hole corners may be left out.
+      if (corners < 2) REQUIRE(flags[static_cast<std::size_t>(f)] == 0);
+      if (corners >= 2 && !flags[static_cast<std::size_t>(f)]) ++repaired;
+      for (int k = 0; k < 3; ++k) {
+        const int a = id[static_cast<std::size_t>(grid(f, k))], b = id[static_cast<std::size_t>(grid(f, (k + 1) % 3))];
+        kept_on_edge[{std::min(a, b), std::max(a, b)}] += flags[static_cast<std::size_t>(f)] ? 0 : 1;
+      }
+    }
+    std::vector<int> boundary(static_cast<std::size_t>(count), 0);
+    for (const auto& [edge, kept] : kept_on_edge)
+      if (kept == 1) ++boundary[static_cast<std::size_t>(edge.first)], ++boundary[static_cast<std::size_t>(edge.second)];
+    for (int b : boundary) REQUIRE(b <= 2);
+  }
+  CHECK(repaired > 0);  // the case arose and was mended
 }
 
 TEST_CASE("fitted geometry image: a mesh with holes keeps its hole texels and gets no worse", "[gim]") {

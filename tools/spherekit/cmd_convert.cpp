@@ -197,7 +197,8 @@ int run_convert(const ConvertArgs& a) {
   if (cancel_requested()) return print_error(cancelled_status());
 
   Stopwatch remesh_time;
-  const TriMesh remesh = geometry_image_mesh(image);
+  // A single mesh's remesh keeps its holes open (the faces spanning them have no counterpart).
+  const TriMesh remesh = geometry_image_open_mesh(image);
   const double remesh_seconds = remesh_time.seconds();
 
   Stopwatch write_time;
@@ -219,8 +220,8 @@ int run_convert(const ConvertArgs& a) {
     Stopwatch psnr_time;
     RemeshErrorOptions opts;
     opts.samples = a.psnr_samples;
-    err = remesh_error(m.mesh, remesh, opts, geometry_image_hole_faces(image));
-    if (has_holes) err_all = remesh_error(m.mesh, remesh, opts);
+    err = remesh_error(m.mesh, remesh, opts);
+    if (has_holes) err_all = remesh_error(m.mesh, geometry_image_mesh(image), opts);
     psnr_seconds = psnr_time.seconds();
   }
   // glTF levels of detail: the position bits come from the error budget of the image's own
@@ -258,7 +259,8 @@ int run_convert(const ConvertArgs& a) {
       for (const convert::GltfLodLevel& level : lods.levels) {
         const convert::GltfMesh& d = level.primitive.decoded.mesh;
         TriMesh decoded{d.V, d.F};
-        lod_errors.push_back(remesh_error(m.mesh, decoded, opts_err, convert::gltf_mesh_hole_faces(d, image)));
+        // The levels leave the holes open: every face of the file counts.
+        lod_errors.push_back(remesh_error(m.mesh, decoded, opts_err));
         if (cancel_requested()) return print_error(cancelled_status());
       }
       gltf_psnr_seconds = t.seconds();
@@ -404,7 +406,8 @@ void register_convert(CLI::App& app) {
       "octahedral geometry image (N = 2^k+1): each texel's sphere point is located in the sphere\n"
       "map and the surface position and normal are interpolated there. Writes a float EXR\n"
       "(R,G,B = position, N.X,N.Y,N.Z = normal, face_id; ZIP; provenance in the header), and\n"
-      "with --remesh the triangle mesh the image defines, and two PNG previews of the image,\n"
+      "with --remesh the triangle mesh the image defines (holes of the mesh left open), and two\n"
+      "PNG previews of the image,\n"
       "OUT_normals.png (normals as colours) and OUT_positions.png (positions in the bounding\n"
       "box as colours; texels in holes of the mesh at half brightness). Prints the remesh PSNR against the\n"
       "original (peak = bounding-box diagonal, symmetric RMS surface distance; for a mesh with\n"

@@ -183,8 +183,15 @@ TriMesh geometry_image_mesh(const GeometryImage& image);
 /// are in a hole. Such faces span (part of) a hole of the source mesh: hole texels sit at the
 /// nearest point of the nearest face, on the hole's rim, so these faces keep the remesh closed
 /// but are not resampled surface. Faces with a single hole texel are kept: they reach from
-/// the surface to the rim and cover the band along it. Empty if image.in_hole is.
+/// the surface to the rim and cover the band along it. So are the hole faces around a vertex
+/// where the kept faces would otherwise meet in two fans, so that the faces left form a
+/// manifold (geometry_image_open_mesh). Empty if image.in_hole is.
 std::vector<std::uint8_t> geometry_image_hole_faces(const GeometryImage& image);
+
+/// The remesh of a mesh with holes with its holes open: geometry_image_mesh(image) without the
+/// faces geometry_image_hole_faces flags and without the vertices no remaining face uses; the
+/// rest keep their order. Equals geometry_image_mesh(image) for an image without hole texels.
+TriMesh geometry_image_open_mesh(const GeometryImage& image);
 
 // ---------------------------------------------------------------------------------------
 // Remesh error (PSNR) — the one definition used everywhere in SphereKit

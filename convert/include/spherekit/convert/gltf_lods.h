@@ -9,8 +9,9 @@
 // better than the finest image subsampled) or the finest image subsampled.
 //
 // Holes. For a mesh with holes, drop_hole_faces leaves out the faces that span a hole
-// (gltf_mesh_hole_faces) and the points only they use, so a viewer shows the holes. A
-// collection keeps them: its members must share one connectivity.
+// (geometry_image_hole_faces of the level's image: what is left is a manifold) and the
+// points only they use, so a viewer shows the holes. A collection keeps them: its members
+// must share one connectivity.
 //
 // Per primitive: POSITION, NORMAL, TEXCOORD_0 in a KHR_draco_mesh_compression bitstream, no
 // uncompressed fallback (the extension is required), accessors written from the decoded data

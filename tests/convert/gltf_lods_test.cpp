@@ -150,17 +150,14 @@ TEST_CASE("glTF LODs: a collection gets one point order per level", "[convert]")
 }
 
 TEST_CASE("glTF LODs of a mesh with holes: each level fitted at its size, hole faces left out", "[convert]") {
-  // Holes a vertex's ring of a level-2 icosphere wide: several texels even at 17 x 17.
-  const TriMesh holed = test::sphere_with_holes(2, 3);
-  const RowMat3d S = holed.V.rowwise().normalized();
+  const test::HoledLodImages holed_images = test::holed_lod_images(65, 3);
+  const TriMesh& holed = holed_images.mesh;
+  const std::vector<GeometryImage>* levels = &holed_images.levels;
+  REQUIRE(levels->size() == 3);
   GeometryImageOptions fit;
   fit.fit_positions = true;
-  auto fine = sample_geometry_image(holed, S, 65, fit);
+  auto fine = sample_geometry_image(holed, holed_images.S, 65, fit);
   REQUIRE(fine.ok());
-  REQUIRE(fine->texels_in_holes > 0);
-  auto levels = lod_geometry_images(holed, S, fine.value(), 3, fit);
-  REQUIRE(levels.ok());
-  REQUIRE(levels->size() == 3);
   RemeshErrorOptions err;
   err.samples = 50000;
   for (std::size_t k = 0; k < 3; ++k) {
@@ -185,9 +182,9 @@ TEST_CASE("glTF LODs of a mesh with holes: each level fitted at its size, hole f
   }
 
   GltfLodOptions options = test::lod_test_options();
-  auto kept = build_gltf_lods(levels.value(), options);
+  auto kept = build_gltf_lods(*levels, options);
   options.drop_hole_faces = true;
-  auto dropped = build_gltf_lods(levels.value(), options);
+  auto dropped = build_gltf_lods(*levels, options);
   REQUIRE(kept.ok());
   REQUIRE(dropped.ok());
   int some_dropped = 0;
@@ -221,7 +218,7 @@ TEST_CASE("glTF LODs of a mesh with holes: each level fitted at its size, hole f
   std::vector<GeometryImage> wrong{fine.value(), fine.value()};
   CHECK(build_gltf_lods(wrong, options).status().code() == ErrorCode::InvalidArgument);
   CHECK(build_gltf_lods(std::vector<GeometryImage>{}, options).status().code() == ErrorCode::InvalidArgument);
-  CHECK(lod_geometry_images(holed, S, fine.value(), 7, fit).status().code() == ErrorCode::InvalidArgument);
+  CHECK(lod_geometry_images(holed, holed_images.S, fine.value(), 7, fit).status().code() == ErrorCode::InvalidArgument);
 }
 
 TEST_CASE("glTF LODs: errors and cancellation", "[convert]") {

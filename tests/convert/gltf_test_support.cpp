@@ -40,6 +40,21 @@ GeometryImage blob_geometry_image(int size, int level, std::uint64_t seed) {
 
 GeometryImage lod_test_image() { return blob_geometry_image(65); }
 
+HoledLodImages holed_lod_images(int size, int levels) {
+  HoledLodImages out;
+  out.mesh = sphere_with_holes(2, 3);
+  out.S = out.mesh.V.rowwise().normalized();
+  GeometryImageOptions fit;
+  fit.fit_positions = true;
+  auto fine = sample_geometry_image(out.mesh, out.S, size, fit);
+  REQUIRE(fine.ok());
+  REQUIRE(fine->texels_in_holes > 0);
+  auto images = convert::lod_geometry_images(out.mesh, out.S, std::move(fine).value(), levels, fit);
+  REQUIRE(images.ok());
+  out.levels = std::move(images).value();
+  return out;
+}
+
 convert::GltfLodOptions lod_test_options() {
   convert::GltfLodOptions options;
   options.levels = 3;

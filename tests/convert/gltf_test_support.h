@@ -27,6 +27,16 @@ GeometryImage blob_geometry_image(int size, int level = 3, std::uint64_t seed = 
 GeometryImage lod_test_image();
 /// Their options: 3 levels (65, 33, 17), an error budget of 1e-4 RMS (the blob is ~2 across).
 convert::GltfLodOptions lod_test_options();
+
+/// A mesh with holes (sphere_with_holes(2, 3): holes a vertex's ring of a level-2 icosphere
+/// wide, several texels even at 17 x 17), its radial sphere map, and the fitted images of
+/// `levels` levels of detail from `size` down (lod_geometry_images; levels[0] the finest).
+struct HoledLodImages {
+  TriMesh mesh;
+  RowMat3d S;
+  std::vector<GeometryImage> levels;
+};
+HoledLodImages holed_lod_images(int size, int levels);
 /// A collection of `members` blobs (seeds 7, 8, ...) as geometry-image primitives of one
 /// connectivity.
 std::vector<convert::GltfMesh> collection_test_meshes(int size, int members = 3);

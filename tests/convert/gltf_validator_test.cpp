@@ -50,17 +50,10 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
   write("single_lods.glb", single->combined_glb);
   // A mesh with holes: levels fitted at their sizes, hole faces left out (as `convert` does).
   {
-    const TriMesh holed = test::sphere_with_holes(2, 3);
-    const RowMat3d S = holed.V.rowwise().normalized();
-    GeometryImageOptions fit;
-    fit.fit_positions = true;
-    auto fine = sample_geometry_image(holed, S, 33, fit);
-    REQUIRE(fine.ok());
-    auto levels = lod_geometry_images(holed, S, fine.value(), 3, fit);
-    REQUIRE(levels.ok());
+    const test::HoledLodImages holed = test::holed_lod_images(33, 3);
     GltfLodOptions open = test::lod_test_options();
     open.drop_hole_faces = true;
-    auto holed_lods = build_gltf_lods(levels.value(), open);
+    auto holed_lods = build_gltf_lods(holed.levels, open);
     REQUIRE(holed_lods.ok());
     auto holed_paths = write_gltf_lods(dir + "/holed", holed_lods.value());
     REQUIRE(holed_paths.ok());

@@ -9,6 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
+
+#include "spherekit/remove_faces.h"
 
 namespace spherekit::convert {
 
@@ -141,38 +144,23 @@ std::vector<std::uint8_t> gltf_mesh_hole_faces(const GltfMesh& mesh, const Geome
 
 GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::uint8_t>& drop) {
   if (drop.size() != static_cast<std::size_t>(mesh.F.rows()) || !check_gltf_mesh(mesh).ok()) return mesh;
-  std::vector<std::int32_t> new_index(static_cast<std::size_t>(mesh.V.rows()), -1);
-  Eigen::Index faces = 0;
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    if (!drop[static_cast<std::size_t>(f)]) {
-      ++faces;
-      for (int k = 0; k < 3; ++k) new_index[static_cast<std::size_t>(mesh.F(f, k))] = 0;
-    }
-  std::int32_t points = 0;
-  for (auto& i : new_index)
-    if (i == 0) i = points++;
+  std::vector<int> new_index;
+  const TriMesh kept = remove_faces(TriMesh{mesh.V, mesh.F}, drop, &new_index);
   GltfMesh out;
+  out.V = kept.V;
+  out.F = kept.F;
   out.texture_size = mesh.texture_size;
-  out.V.resize(points, 3);
-  if (mesh.N.rows() > 0) out.N.resize(points, 3);
-  if (mesh.UV.rows() > 0) out.UV.resize(points, 2);
-  if (!mesh.position_index.empty()) out.position_index.resize(static_cast<std::size_t>(points));
+  if (mesh.N.rows() > 0) out.N.resize(kept.V.rows(), 3);
+  if (mesh.UV.rows() > 0) out.UV.resize(kept.V.rows(), 2);
+  if (!mesh.position_index.empty()) out.position_index.resize(static_cast<std::size_t>(kept.V.rows()));
   for (Eigen::Index p = 0; p < mesh.V.rows(); ++p) {
-    const std::int32_t q = new_index[static_cast<std::size_t>(p)];
+    const int q = new_index[static_cast<std::size_t>(p)];
     if (q < 0) continue;
-    out.V.row(q) = mesh.V.row(p);
     if (mesh.N.rows() > 0) out.N.row(q) = mesh.N.row(p);
     if (mesh.UV.rows() > 0) out.UV.row(q) = mesh.UV.row(p);
     if (!mesh.position_index.empty())
       out.position_index[static_cast<std::size_t>(q)] = mesh.position_index[static_cast<std::size_t>(p)];
   }
-  out.F.resize(faces, 3);
-  Eigen::Index row = 0;
-  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
-    if (!drop[static_cast<std::size_t>(f)]) {
-      for (int k = 0; k < 3; ++k) out.F(row, k) = new_index[static_cast<std::size_t>(mesh.F(f, k))];
-      ++row;
-    }
   return out;
 }
 

@@ -13,7 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "detail/check_topology.h"
 #include "detail/sphere_locator.h"
+#include "spherekit/remove_faces.h"
 
 namespace spherekit {
 namespace {
@@ -225,71 +227,33 @@ std::vector<std::uint8_t> geometry_image_hole_faces(const GeometryImage& image) 
   if (!any) return out;
 
   // The faces left must stay a manifold: where two holes (or two arms of one) meet at a
-  // vertex, their kept faces would form two fans joined only there. Such a vertex has more
-  // than two boundary edges; its hole faces are kept until no vertex has (the set of kept
-  // faces only grows, so this ends).
+  // vertex, their kept faces would form two fans joined only there. The hole faces around
+  // such a vertex are kept until there is none (the set of kept faces only grows, so this
+  // ends). Fans are counted as check_mesh counts them.
   int vertices = 0;
   const std::vector<int> id = geometry_image_welded_ids(n, &vertices);
-  const auto nv = static_cast<std::uint64_t>(vertices);
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> half_edges;  // (edge key, face)
-  half_edges.reserve(3 * faces);
-  for (std::size_t f = 0; f < faces; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const auto a = static_cast<std::uint64_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))]);
-      const auto b = static_cast<std::uint64_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), (k + 1) % 3))]);
-      half_edges.emplace_back(std::min(a, b) * nv + std::max(a, b), static_cast<std::uint32_t>(f));
-    }
-  std::sort(half_edges.begin(), half_edges.end());
-  std::vector<int> boundary(static_cast<std::size_t>(vertices));
-  std::vector<std::uint8_t> pinched(static_cast<std::size_t>(vertices));
+  TriMesh kept;
+  kept.V = RowMat3d::Zero(vertices, 3);  // only the vertex count matters
   for (;;) {
-    std::fill(boundary.begin(), boundary.end(), 0);
-    // The welded grid is closed: every edge has exactly two faces, adjacent after sorting.
-    for (std::size_t e = 0; e + 1 < half_edges.size(); e += 2)
-      if (out[half_edges[e].second] != out[half_edges[e + 1].second]) {
-        ++boundary[static_cast<std::size_t>(half_edges[e].first / nv)];
-        ++boundary[static_cast<std::size_t>(half_edges[e].first % nv)];
-      }
-    bool found = false;
-    for (std::size_t v = 0; v < boundary.size(); ++v) {
-      pinched[v] = boundary[v] > 2 ? 1 : 0;
-      found = found || pinched[v];
+    kept.F.resize(static_cast<Eigen::Index>(std::count(out.begin(), out.end(), 0)), 3);
+    Eigen::Index row = 0;
+    for (std::size_t f = 0; f < faces; ++f) {
+      if (out[f]) continue;
+      for (int k = 0; k < 3; ++k) kept.F(row, k) = id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))];
+      ++row;
     }
-    if (!found) return out;
+    const std::vector<int> fans = detail::fans_per_vertex(kept, detail::corner_fans(kept, detail::build_topology(kept)));
+    bool pinched = false;
     for (std::size_t f = 0; f < faces; ++f)
       for (int k = 0; k < 3 && out[f]; ++k)
-        if (pinched[static_cast<std::size_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))])]) out[f] = 0;
+        if (fans[static_cast<std::size_t>(id[static_cast<std::size_t>(grid(static_cast<Eigen::Index>(f), k))])] > 1)
+          out[f] = 0, pinched = true;
+    if (!pinched) return out;
   }
 }
 
 TriMesh geometry_image_open_mesh(const GeometryImage& image) {
-  TriMesh closed = geometry_image_mesh(image);
-  const std::vector<std::uint8_t> drop = geometry_image_hole_faces(image);
-  if (drop.size() != static_cast<std::size_t>(closed.F.rows()) ||
-      std::find(drop.begin(), drop.end(), 1) == drop.end())
-    return closed;
-  std::vector<int> new_index(static_cast<std::size_t>(closed.V.rows()), -1);
-  Eigen::Index faces = 0;
-  for (Eigen::Index f = 0; f < closed.F.rows(); ++f)
-    if (!drop[static_cast<std::size_t>(f)]) {
-      ++faces;
-      for (int k = 0; k < 3; ++k) new_index[static_cast<std::size_t>(closed.F(f, k))] = 0;
-    }
-  int vertices = 0;
-  for (int& i : new_index)
-    if (i == 0) i = vertices++;
-  TriMesh open;
-  open.V.resize(vertices, 3);
-  for (Eigen::Index v = 0; v < closed.V.rows(); ++v)
-    if (const int i = new_index[static_cast<std::size_t>(v)]; i >= 0) open.V.row(i) = closed.V.row(v);
-  open.F.resize(faces, 3);
-  Eigen::Index row = 0;
-  for (Eigen::Index f = 0; f < closed.F.rows(); ++f) {
-    if (drop[static_cast<std::size_t>(f)]) continue;
-    for (int k = 0; k < 3; ++k) open.F(row, k) = new_index[static_cast<std::size_t>(closed.F(f, k))];
-    ++row;
-  }
-  return open;
+  return remove_faces(geometry_image_mesh(image), geometry_image_hole_faces(image));
 }
 
 // ---------------------------------------------------------------------------------------

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "spherekit/geometry_image.h"
+#include "spherekit/remove_faces.h"
 #include "test_meshes.h"
 
 namespace {
@@ -563,4 +564,24 @@ TEST_CASE("fitted geometry image: input that is not a sampled image is refused",
   const RowMat3d wrong = radial(blob).topRows(4);
   CHECK(fit_geometry_image_positions(blob, wrong, &gi).code() == ErrorCode::InvalidInput);
   CHECK(gi.positions == r.value().positions);
+}
+
+TEST_CASE("remove_faces keeps the other faces in order and drops only unused vertices", "[gim]") {
+  const TriMesh ico = test::icosphere(1);
+  std::vector<std::uint8_t> drop(static_cast<std::size_t>(ico.F.rows()), 0);
+  drop[0] = 1;
+  std::vector<int> index;
+  const TriMesh out = remove_faces(ico, drop, &index);
+  CHECK(out.F.rows() == ico.F.rows() - 1);
+  CHECK(out.V.rows() == ico.V.rows());  // every vertex still has a face
+  for (Eigen::Index f = 1; f < ico.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) REQUIRE(out.V.row(out.F(f - 1, k)) == ico.V.row(ico.F(f, k)));
+  // A face index out of range, or flags of the wrong count: unchanged, identity map.
+  TriMesh bad = ico;
+  bad.F(3, 1) = static_cast<int>(ico.V.rows());
+  const TriMesh same = remove_faces(bad, drop, &index);
+  CHECK(same.F == bad.F);
+  CHECK(index.size() == static_cast<std::size_t>(ico.V.rows()));
+  CHECK(index.back() == static_cast<int>(ico.V.rows()) - 1);
+  CHECK(remove_faces(ico, {}).F == ico.F);
 }

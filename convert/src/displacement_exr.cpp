@@ -1,5 +1,5 @@
-// Displacement atlases <-> OpenEXR (layout in displacement_exr.h). Encoded in memory and
-// written with formats::write_file_atomic, as geometry images are.
+// Displacement textures <-> OpenEXR (layout in displacement_exr.h and cage_uv_atlas.h). Encoded
+// in memory and written with formats::write_file_atomic, as geometry images are.
 #include "spherekit/convert/displacement_exr.h"
 
 #include <ImfChannelList.h>
@@ -9,8 +9,6 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
-#include <cmath>
-#include <cstdint>
 #include <exception>
 #include <string>
 #include <vector>
@@ -22,16 +20,13 @@
 namespace spherekit::convert {
 namespace {
 
-const char* const kScalarChannel = "D";
+const char* const kScalarChannel = "Y";
 const char* const kVectorChannels[3] = {"R", "G", "B"};
-const char* const kHoleChannel = "in_hole";
+const char* const kTexelCentres =
+    "texel (x, y) from the bottom-left has its value at UV ((x+0.5)/W, (y+0.5)/H); quad corners at the centres of "
+    "their tile's corner texels";
 
-// Atlas pixel index of sample (r, c) of quad f.
-std::size_t atlas_index(int f, int r, int c, int tile, int columns) {
-  const int width = columns * tile;
-  const int x = (f % columns) * tile + c, y = (f / columns) * tile + r;
-  return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
-}
+const char* channel_name(int channels, int k) { return channels == 1 ? kScalarChannel : kVectorChannels[k]; }
 
 bool parse_int(const std::map<std::string, std::string>& a, const char* key, int& out) {
   auto it = a.find(key);
@@ -47,62 +42,44 @@ bool parse_int(const std::map<std::string, std::string>& a, const char* key, int
 
 }  // namespace
 
-int displacement_atlas_columns(int faces) {
-  int c = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(faces))));
-  while (c > 1 && (c - 1) * (c - 1) >= faces) --c;
-  while (c * c < faces) ++c;
-  return std::max(c, 1);
-}
-
-Status write_displacement_exr(const std::string& path, const DisplacementMap& map,
+Status write_displacement_exr(const std::string& path, const DisplacementMap& map, const CageUvAtlas& atlas,
                               const DisplacementProvenance& provenance) {
   const int T = map.tile, nf = map.faces, ch = map.channels();
   const std::size_t samples = static_cast<std::size_t>(nf) * T * T;
-  if (T < 2 || nf < 1 || map.values.size() != samples * ch || map.in_hole.size() != samples)
+  if (T < 2 || nf < 1 || map.values.size() != samples * ch)
     return Status(ErrorCode::InvalidArgument, path + ": malformed displacement map");
-  const int columns = displacement_atlas_columns(nf);
-  const int rows = (nf + columns - 1) / columns;
-  const int width = columns * T, height = rows * T;
-  const std::size_t pixels = static_cast<std::size_t>(width) * height;
-  std::vector<float> planes(pixels * ch, 0.0f);
-  std::vector<std::uint32_t> holes(pixels, 0);
-  for (int f = 0; f < nf; ++f)
-    for (int r = 0; r < T; ++r)
-      for (int c = 0; c < T; ++c) {
-        const std::size_t s = (static_cast<std::size_t>(f) * T + r) * T + c, p = atlas_index(f, r, c, T, columns);
-        for (int k = 0; k < ch; ++k) planes[p * ch + k] = map.values[s * ch + k];
-        holes[p] = map.in_hole[s];
-      }
+  auto expected = cage_uv_atlas(nf, T, atlas.gutter);
+  if (!expected.ok() || expected->columns != atlas.columns || expected->rows != atlas.rows ||
+      atlas.faces != nf || atlas.tile != T)
+    return Status(ErrorCode::InvalidArgument, path + ": the UV atlas does not match the displacement map");
+  const int width = atlas.width(), height = atlas.height();
+  std::vector<float> planes = cage_atlas_image(atlas, map.values, ch);
   std::string bytes;
   try {
     Imf::Header header(width, height);
     header.compression() = Imf::ZIP_COMPRESSION;
-    const bool scalar = map.kind == DisplacementKind::Scalar;
-    if (scalar)
-      header.channels().insert(kScalarChannel, Imf::Channel(Imf::FLOAT));
-    else
-      for (const char* c : kVectorChannels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
-    header.channels().insert(kHoleChannel, Imf::Channel(Imf::UINT));
-    header.insert("spherekit_version", Imf::StringAttribute(kVersion));
-    header.insert("format_version", Imf::StringAttribute(std::to_string(kFormatVersion)));
-    header.insert("layout", Imf::StringAttribute("cube-cage-atlas"));
-    header.insert("displacement", Imf::StringAttribute(scalar ? "scalar" : "vector"));
-    header.insert("cage_n", Imf::StringAttribute(std::to_string(map.cage_n)));
-    header.insert("faces", Imf::StringAttribute(std::to_string(nf)));
-    header.insert("tile", Imf::StringAttribute(std::to_string(T)));
-    header.insert("tile_columns", Imf::StringAttribute(std::to_string(columns)));
-    header.insert("source_mesh", Imf::StringAttribute(provenance.source_mesh));
-    header.insert("sphere_map", Imf::StringAttribute(provenance.sphere_map));
-    header.insert("cage", Imf::StringAttribute(provenance.cage));
+    for (int k = 0; k < ch; ++k) header.channels().insert(channel_name(ch, k), Imf::Channel(Imf::FLOAT));
+    auto put = [&](const char* key, const std::string& value) { header.insert(key, Imf::StringAttribute(value)); };
+    put("spherekit_version", kVersion);
+    put("format_version", std::to_string(kFormatVersion));
+    put("layout", "cage-uv-atlas");
+    put("displacement", ch == 1 ? "scalar" : "vector");
+    put("normal", "limit");
+    put("cage_n", std::to_string(map.cage_n));
+    put("faces", std::to_string(nf));
+    put("tile", std::to_string(T));
+    put("gutter", std::to_string(atlas.gutter));
+    put("tile_columns", std::to_string(atlas.columns));
+    put("tile_rows", std::to_string(atlas.rows));
+    put("texel_centres", kTexelCentres);
+    put("samples_in_holes", std::to_string(map.samples_in_holes));
+    put("source_mesh", provenance.source_mesh);
+    put("sphere_map", provenance.sphere_map);
+    put("cage", provenance.cage);
     Imf::FrameBuffer fb;
     const std::size_t xs = sizeof(float) * ch, ys = xs * width;
-    if (scalar)
-      fb.insert(kScalarChannel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes.data()), xs, ys));
-    else
-      for (int k = 0; k < 3; ++k)
-        fb.insert(kVectorChannels[k], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes.data() + k), xs, ys));
-    fb.insert(kHoleChannel, Imf::Slice(Imf::UINT, reinterpret_cast<char*>(holes.data()), sizeof(std::uint32_t),
-                                       sizeof(std::uint32_t) * width));
+    for (int k = 0; k < ch; ++k)
+      fb.insert(channel_name(ch, k), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes.data() + k), xs, ys));
     detail::MemoryStream stream;
     {
       Imf::OutputFile file(stream, header, 1);
@@ -125,52 +102,39 @@ Result<DisplacementFile> read_displacement_exr(const std::string& path) {
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
         out.attributes[it.name()] = s->value();
     DisplacementMap& map = out.map;
-    int columns = 0;
-    if (out.attributes["layout"] != "cube-cage-atlas" || !parse_int(out.attributes, "cage_n", map.cage_n) ||
+    int gutter = 0, columns = 0, rows = 0;
+    if (out.attributes["layout"] != "cage-uv-atlas" || !parse_int(out.attributes, "cage_n", map.cage_n) ||
         !parse_int(out.attributes, "faces", map.faces) || !parse_int(out.attributes, "tile", map.tile) ||
-        !parse_int(out.attributes, "tile_columns", columns))
-      return Status(ErrorCode::InvalidInput, path + ": not a SphereKit displacement atlas (header attributes missing)");
+        !parse_int(out.attributes, "gutter", gutter) || !parse_int(out.attributes, "tile_columns", columns) ||
+        !parse_int(out.attributes, "tile_rows", rows))
+      return Status(ErrorCode::InvalidInput, path + ": not a SphereKit displacement texture (header attributes missing)");
     const std::string kind = out.attributes["displacement"];
     if (kind != "scalar" && kind != "vector")
       return Status(ErrorCode::InvalidInput, path + ": unknown displacement kind '" + kind + "'");
     map.kind = kind == "scalar" ? DisplacementKind::Scalar : DisplacementKind::Vector;
+    if (!parse_int(out.attributes, "samples_in_holes", map.samples_in_holes)) map.samples_in_holes = 0;
     const Imath::Box2i dw = header.dataWindow();
     const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
-    const int T = map.tile, nf = map.faces;
-    if (T < 2 || nf < 1 || map.cage_n < 1 || nf != 6 * map.cage_n * map.cage_n ||
-        columns != displacement_atlas_columns(nf) || width != columns * T ||
-        height != ((nf + columns - 1) / columns) * T)
-      return Status(ErrorCode::InvalidInput, path + ": atlas size does not match its tile attributes");
+    auto atlas = cage_uv_atlas(map.faces, map.tile, gutter);
+    if (!atlas.ok() || map.cage_n < 1 || map.faces != 6 * map.cage_n * map.cage_n || atlas->columns != columns ||
+        atlas->rows != rows || width != atlas->width() || height != atlas->height())
+      return Status(ErrorCode::InvalidInput, path + ": texture size does not match its atlas attributes");
+    out.atlas = atlas.value();
     const int ch = map.channels();
-    for (int k = 0; k < ch; ++k) {
-      const char* name = ch == 1 ? kScalarChannel : kVectorChannels[k];
-      if (!header.channels().findChannel(name))
-        return Status(ErrorCode::InvalidInput, path + ": channel " + name + " is missing");
-    }
-    const std::size_t pixels = static_cast<std::size_t>(width) * height;
-    std::vector<float> planes(pixels * ch, 0.0f);
-    std::vector<std::uint32_t> holes(pixels, 0);
+    for (int k = 0; k < ch; ++k)
+      if (!header.channels().findChannel(channel_name(ch, k)))
+        return Status(ErrorCode::InvalidInput, path + ": channel " + channel_name(ch, k) + " is missing");
+    std::vector<float> planes(static_cast<std::size_t>(width) * height * ch, 0.0f);
     const std::ptrdiff_t origin = static_cast<std::ptrdiff_t>(dw.min.y) * width + dw.min.x;
     const std::size_t xs = sizeof(float) * ch, ys = xs * width;
     Imf::FrameBuffer fb;
     for (int k = 0; k < ch; ++k)
-      fb.insert(ch == 1 ? kScalarChannel : kVectorChannels[k],
+      fb.insert(channel_name(ch, k),
                 Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes.data() + k - ch * origin), xs, ys));
-    fb.insert(kHoleChannel, Imf::Slice(Imf::UINT, reinterpret_cast<char*>(holes.data() - origin), sizeof(std::uint32_t),
-                                       sizeof(std::uint32_t) * width, 1, 1, 0.0));
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
-    const std::size_t samples = static_cast<std::size_t>(nf) * T * T;
-    map.values.assign(samples * ch, 0.0f);
-    map.in_hole.assign(samples, 0);
-    for (int f = 0; f < nf; ++f)
-      for (int r = 0; r < T; ++r)
-        for (int c = 0; c < T; ++c) {
-          const std::size_t s = (static_cast<std::size_t>(f) * T + r) * T + c, p = atlas_index(f, r, c, T, columns);
-          for (int k = 0; k < ch; ++k) map.values[s * ch + k] = planes[p * ch + k];
-          map.in_hole[s] = holes[p] ? 1 : 0;
-          map.samples_in_holes += map.in_hole[s];
-        }
+    map.values = cage_atlas_samples(out.atlas, planes, ch);
+    map.in_hole.assign(static_cast<std::size_t>(map.faces) * map.tile * map.tile, 0);
   } catch (const std::exception& e) {
     return Status(ErrorCode::IoError, path + ": cannot read EXR (" + e.what() + ")");
   }

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -78,10 +79,37 @@ TEST_CASE("convert --cage writes the cage and the displacement atlas, and the di
   CHECK(c["control_points"] == 26);
   CHECK(c["file"] == dir + "/blob_cage.obj");
   CHECK(c["psnr_db"].get<double>() > c["psnr_db_limit"].get<double>() + 6);
-  CHECK(face_lines(dir + "/blob_cage.obj").size() == 24);
+  const std::vector<std::string> faces = face_lines(dir + "/blob_cage.obj");
+  CHECK(faces.size() == 24);
   auto atlas = convert::read_displacement_exr(dir + "/blob_disp.exr");
   REQUIRE(atlas.ok());
   CHECK(atlas->map.tile == 9);
+  // Texture coordinates: four per quad, `f v/vt` corners, each the centre of a corner texel of
+  // the quad's tile in the texture.
+  std::vector<Eigen::Vector2d> vt;
+  {
+    std::istringstream in(slurp(dir + "/blob_cage.obj"));
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("vt ", 0) == 0) {
+        std::istringstream f(line.substr(3));
+        Eigen::Vector2d t;
+        f >> t.x() >> t.y();
+        vt.push_back(t);
+      }
+  }
+  REQUIRE(vt.size() == 96);
+  const int W = atlas->atlas.width(), H = atlas->atlas.height();
+  for (int f = 0; f < 24; ++f) {
+    int corners[4][2];
+    REQUIRE(std::sscanf(faces[static_cast<std::size_t>(f)].c_str(), "f %*d/%d %*d/%d %*d/%d %*d/%d", &corners[0][1],
+                        &corners[1][1], &corners[2][1], &corners[3][1]) == 4);
+    const int cu[4] = {0, 8, 8, 0}, cv[4] = {0, 0, 8, 8};
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d t = vt[static_cast<std::size_t>(corners[k][1] - 1)];
+      CHECK(t.x() * W == Approx(atlas->atlas.texel_x(f, cu[k]) + 0.5).margin(1e-4));
+      CHECK(t.y() * H == Approx(atlas->atlas.texel_y(f, cv[k]) + 0.5).margin(1e-4));
+    }
+  }
   CHECK(atlas->map.kind == convert::DisplacementKind::Scalar);
   CHECK(atlas->attributes.at("source_mesh") == dir + "/blob.obj");
 

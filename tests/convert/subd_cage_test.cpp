@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "spherekit/convert/cage_uv_atlas.h"
 #include "spherekit/convert/displacement.h"
 #include "spherekit/convert/displacement_exr.h"
 #include "spherekit/convert/geometry_image_exr.h"
@@ -194,7 +195,7 @@ TEST_CASE("cage fit and displacement do not depend on the thread count", "[conve
   CHECK(m1->values == m2->values);
 }
 
-TEST_CASE("displacement atlas EXR: round trip is bit-exact, bad files are refused", "[convert][cage]") {
+TEST_CASE("displacement texture EXR: round trip is bit-exact, bad files are refused", "[convert][cage]") {
   const TriMesh blob = test::random_blob(3, 4);
   const RowMat3d S = blob.V.rowwise().normalized();
   auto dom = cube_cage_domain(2);
@@ -202,37 +203,93 @@ TEST_CASE("displacement atlas EXR: round trip is bit-exact, bad files are refuse
   auto cage = fit_subd_cage(blob, S, limit.value(), dom.value());
   REQUIRE(cage.ok());
   const std::string dir = test::temp_dir("disp_exr");
-  for (DisplacementKind kind : {DisplacementKind::Scalar, DisplacementKind::Vector}) {
-    DisplacementOptions o;
-    o.tile = 9;
-    o.kind = kind;
-    auto map = sample_displacement(blob, S, cage.value(), limit.value(), o);
-    REQUIRE(map.ok());
-    const std::string path = dir + (kind == DisplacementKind::Scalar ? "/d1.exr" : "/d3.exr");
-    REQUIRE(write_displacement_exr(path, map.value(), {"blob.obj", "blob.sphere.obj", "blob.cage.obj"}).ok());
-    auto back = read_displacement_exr(path);
-    REQUIRE(back.ok());
-    CHECK(back->map.kind == kind);
-    CHECK(back->map.tile == 9);
-    CHECK(back->map.faces == 24);
-    CHECK(back->map.cage_n == 2);
-    REQUIRE(back->map.values.size() == map->values.size());
-    CHECK(std::memcmp(back->map.values.data(), map->values.data(), map->values.size() * sizeof(float)) == 0);
-    CHECK(back->map.in_hole == map->in_hole);
-    CHECK(back->attributes.at("layout") == "cube-cage-atlas");
-    CHECK(back->attributes.at("source_mesh") == "blob.obj");
-    // 24 tiles of 9 x 9 in 5 columns x 5 rows.
-    CHECK(displacement_atlas_columns(24) == 5);
-  }
-  // A geometry image is not a displacement atlas.
+  for (DisplacementKind kind : {DisplacementKind::Scalar, DisplacementKind::Vector})
+    for (int gutter : {0, 2}) {
+      DisplacementOptions o;
+      o.tile = 9;
+      o.kind = kind;
+      auto map = sample_displacement(blob, S, cage.value(), limit.value(), o);
+      REQUIRE(map.ok());
+      auto atlas = cage_uv_atlas(map->faces, 9, gutter);
+      REQUIRE(atlas.ok());
+      const std::string path = dir + "/d" + std::to_string(map->channels()) + "_" + std::to_string(gutter) + ".exr";
+      REQUIRE(write_displacement_exr(path, map.value(), atlas.value(), {"blob.obj", "blob.sphere.obj", "blob.cage.obj"}).ok());
+      auto back = read_displacement_exr(path);
+      REQUIRE(back.ok());
+      CHECK(back->map.kind == kind);
+      CHECK(back->map.tile == 9);
+      CHECK(back->map.faces == 24);
+      CHECK(back->map.cage_n == 2);
+      CHECK(back->atlas.gutter == gutter);
+      // 24 tiles in 5 columns x 5 rows of 9 + 2g texels.
+      CHECK(back->atlas.columns == 5);
+      CHECK(back->atlas.rows == 5);
+      CHECK(back->atlas.width() == 5 * (9 + 2 * gutter));
+      REQUIRE(back->map.values.size() == map->values.size());
+      CHECK(std::memcmp(back->map.values.data(), map->values.data(), map->values.size() * sizeof(float)) == 0);
+      CHECK(back->map.samples_in_holes == map->samples_in_holes);
+      CHECK(back->attributes.at("layout") == "cage-uv-atlas");
+      CHECK(back->attributes.at("source_mesh") == "blob.obj");
+      // An atlas of another tile size is refused.
+      auto other = cage_uv_atlas(map->faces, 5, gutter);
+      CHECK(write_displacement_exr(dir + "/bad.exr", map.value(), other.value()).code() == ErrorCode::InvalidArgument);
+      CHECK_FALSE(fs::exists(dir + "/bad.exr"));
+    }
+  // A geometry image is not a displacement texture.
   auto gi = sample_geometry_image(blob, S, 9);
   REQUIRE(gi.ok());
   REQUIRE(write_geometry_image_exr(dir + "/gi.exr", gi.value()).ok());
   auto wrong = read_displacement_exr(dir + "/gi.exr");
   CHECK(wrong.status().code() == ErrorCode::InvalidInput);
-  CHECK(displacement_atlas_columns(1) == 1);
-  CHECK(displacement_atlas_columns(6) == 3);
-  CHECK(displacement_atlas_columns(96) == 10);
   auto missing = read_displacement_exr(dir + "/none.exr");
   CHECK(missing.status().code() == ErrorCode::IoError);
+}
+
+TEST_CASE("cage UV atlas: corner UVs are tile texel centres, gutters extrapolate linearly", "[convert][cage]") {
+  CHECK(cage_uv_atlas(1, 9, 2)->columns == 1);
+  CHECK(cage_uv_atlas(6, 9, 2)->columns == 3);
+  CHECK(cage_uv_atlas(6, 9, 2)->rows == 2);
+  CHECK(cage_uv_atlas(96, 9, 2)->columns == 10);
+  CHECK(cage_uv_atlas(0, 9, 2).status().code() == ErrorCode::InvalidArgument);
+  CHECK(cage_uv_atlas(6, 1, 2).status().code() == ErrorCode::InvalidArgument);
+  CHECK(cage_uv_atlas(6, 9, -1).status().code() == ErrorCode::InvalidArgument);
+  const int T = 5, g = 2, faces = 7;
+  auto atlas = cage_uv_atlas(faces, T, g);
+  REQUIRE(atlas.ok());
+  const int W = atlas->width(), H = atlas->height(), P = T + 2 * g;
+  CHECK(W == 3 * P);
+  CHECK(H == 3 * P);
+  // Per tile a linear function of (r, c) in both channels: the gutters must continue it exactly.
+  std::vector<float> values(static_cast<std::size_t>(faces) * T * T * 2);
+  auto value = [](int f, int r, int c, int ch) { return ch == 0 ? f + 0.25 * r - 0.5 * c : -f * 0.125 + 0.75 * c; };
+  for (int f = 0; f < faces; ++f)
+    for (int r = 0; r < T; ++r)
+      for (int c = 0; c < T; ++c)
+        for (int ch = 0; ch < 2; ++ch)
+          values[((static_cast<std::size_t>(f) * T + r) * T + c) * 2 + ch] = static_cast<float>(value(f, r, c, ch));
+  const std::vector<float> image = cage_atlas_image(atlas.value(), values, 2);
+  REQUIRE(image.size() == static_cast<std::size_t>(W) * H * 2);
+  for (int f = 0; f < faces; ++f) {
+    // The UV of a sample parameter is its texel's centre (y from the bottom).
+    for (int r = 0; r < T; ++r)
+      for (int c = 0; c < T; ++c) {
+        const Eigen::Vector2d uv = atlas->uv(f, double(c) / (T - 1), double(r) / (T - 1));
+        const int x = static_cast<int>(std::floor(uv.x() * W)), y = static_cast<int>(std::floor(uv.y() * H));
+        CHECK(x == atlas->texel_x(f, c));
+        CHECK(y == atlas->texel_y(f, r));
+        CHECK(std::abs(uv.x() * W - x - 0.5) < 1e-9);
+        CHECK(std::abs(uv.y() * H - y - 0.5) < 1e-9);
+      }
+    for (int r = -g; r < T + g; ++r)
+      for (int c = -g; c < T + g; ++c)
+        for (int ch = 0; ch < 2; ++ch) {
+          const int x = atlas->texel_x(f, c), y = atlas->texel_y(f, r);
+          REQUIRE(x >= 0);
+          REQUIRE(x < W);
+          CHECK(image[(static_cast<std::size_t>(H - 1 - y) * W + x) * 2 + ch] == Approx(value(f, r, c, ch)).margin(1e-5));
+        }
+  }
+  // Blocks of quads that do not exist stay 0; the samples read back exactly.
+  CHECK(image[(static_cast<std::size_t>(H - 1 - atlas->texel_y(8, 0)) * W + atlas->texel_x(8, 0)) * 2] == 0.0f);
+  CHECK(cage_atlas_samples(atlas.value(), image, 2) == values);
 }

@@ -104,8 +104,11 @@ Result<CageOutput> build_cage(const TriMesh& mesh, const RowMat3d& S, const Conv
   if (!disp.ok()) return disp.status();
   out.cage_path = prefix + "_cage.obj";
   out.displacement_path = prefix + "_disp.exr";
-  if (Status s = convert::write_cage_obj(out.cage_path, cage.value(), "fitted to " + a.mesh); !s.ok()) return s;
-  if (Status s = convert::write_displacement_exr(out.displacement_path, disp.value(),
+  auto atlas = convert::cage_uv_atlas(disp->faces, disp->tile, convert::kDefaultDisplacementGutter);
+  if (!atlas.ok()) return atlas.status();
+  if (Status s = convert::write_cage_obj(out.cage_path, cage.value(), "fitted to " + a.mesh, &atlas.value()); !s.ok())
+    return s;
+  if (Status s = convert::write_displacement_exr(out.displacement_path, disp.value(), atlas.value(),
                                                  {a.mesh, a.sphere, out.cage_path});
       !s.ok())
     return s;

@@ -127,7 +127,14 @@ struct SubdCage {
                                              const CageDomain& domain, const CageFitOptions& options = {},
                                              const ProgressFn& progress = {});
 
-/// Writes the cage as an OBJ (v lines, then quad f lines, 1-based), atomically.
-[[nodiscard]] Status write_cage_obj(const std::string& path, const SubdCage& cage, const std::string& comment = {});
+struct CageUvAtlas;
+
+/// Writes the cage as an OBJ (v lines, then quad f lines, 1-based), atomically. With `uv`, also
+/// four `vt` lines per quad, in quad order (the UVs of its corners 0..3, cage_uv_atlas.h), and
+/// `f v/vt ...` faces: every quad its own chart, so a tool that subdivides the cage with
+/// linear face-varying interpolation (Blender: UV Smooth "None"; OpenSubdiv
+/// FVAR_LINEAR_ALL) maps the limit-surface parameter (u, v) bilinearly onto the quad's tile.
+[[nodiscard]] Status write_cage_obj(const std::string& path, const SubdCage& cage, const std::string& comment = {},
+                                    const CageUvAtlas* uv = nullptr);
 
 }  // namespace spherekit::convert

@@ -5,13 +5,16 @@
 // requests, waits until the viewer has loaded everything (window.spherekitViewer.pending == 0),
 // screenshots every 3-D canvas and counts its pixels that differ from the canvas background,
 // for every level of detail (LOD buttons), every model of the selector, the automatic level
-// after zooming out with the mouse wheel, and both ends of every morph slider, and checks the
+// after zooming out with the mouse wheel, every model and all side by side with and without the
+// shared texture and on its sphere, and both ends of every morph slider, and checks the
 // images and tables. Screenshots go to SHOT_DIR. Prints one JSON document on stdout (the
 // caller judges it; "error" when a step threw):
 //   {"chromium": version, "modes": [{"mode", "url", "seconds", "error", "console_errors": [], "console_warnings": [],
 //     "page_errors": [], "failed_requests": [], "viewer_errors": [], "images", "broken_images", "tables",
 //     "models": [{"name", "lods": [{"lod", "triangles", "coverage", "shot"}]}], "auto_lod": {"before", "after_zoom_out"},
-//     "morphs": [{"targets", "coverage_start", "coverage_end", "changed_fraction", "shots"}]}]}
+//     "morphs": [{"targets", "coverage_start", "coverage_end", "changed_fraction", "shots"}],
+//     "textures": [{"model" (index or "all"), "coverage_plain", "coverage_textured", "changed_fraction",
+//       "coverage_sphere", "sphere_changed_fraction", "shots"}]}]}
 // Packages are loaded from NODE_DIR/node_modules (scripts/setup_viewer.sh --browser installs
 // them); Chromium from $CHROMIUM, default /usr/bin/chromium.
 // Exit code 0 when it ran (whatever it found), 1 when the browser could not be driven, 2 on usage errors.
@@ -35,7 +38,7 @@ const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
 // The page's canvas background (viewer.js BACKGROUND) and how far a pixel must be from it to count.
 const BACKGROUND = [0x20, 0x25, 0x2b], THRESHOLD = 30;
 // Whole run: well under the test's budget even on a loaded machine.
-const watchdog = setTimeout(() => { console.error('site_browser_check: timed out after 100 s'); process.exit(1); }, 100000);
+const watchdog = setTimeout(() => { console.error('site_browser_check: timed out after 240 s'); process.exit(1); }, 240000);
 
 // ---- PNG decoding (8-bit, non-interlaced: what Chromium's screenshots are), to count pixels.
 function decodePng(buf) {
@@ -112,7 +115,7 @@ async function check(context, mode, url) {
   const started = Date.now();
   const page = await context.newPage();
   const r = { mode, url, console_errors: [], console_warnings: [], page_errors: [], failed_requests: [], viewer_errors: [],
-              models: [], morphs: [] };
+              models: [], morphs: [], textures: [] };
   page.on('console', (m) => {
     // Chromium's own performance note when a canvas is read back (the screenshots): not the page's.
     if (/GPU stall due to ReadPixels/.test(m.text())) return;
@@ -172,6 +175,42 @@ async function viewerChecks(page, mode, r) {
     await settle(page);
     r.auto_lod = { before, after_zoom_out: await page.evaluate(() => window.spherekitViewer.lod) };
     await shoot(page, '#model-canvas', `${mode}_auto_zoomed_out.png`);
+  }
+  // The shared texture (issue 22): on every model, and on all side by side, the grid through
+  // TEXCOORD_0 changes the model's pixels against the grey render; each is also shown on its
+  // sphere.
+  const hasTexture = await page.evaluate(() => !!document.querySelector('#shared-texture'));
+  if (hasTexture && r.models.length) {
+    const targets = r.models.length > 1 ? ['all', ...r.models.map((_, m) => m)] : [0];
+    for (const target of targets) {
+      if (await failed()) break;
+      await page.evaluate((v) => {
+        const s = document.querySelector('#model-select');
+        s.value = v;
+        s.dispatchEvent(new Event('change'));
+      }, String(target));
+      await page.waitForFunction((t) => window.spherekitViewer.model === t, target);
+      await settle(page);
+      await page.click('#lod-buttons button[data-lod="0"]');
+      await page.waitForFunction(() => window.spherekitViewer.lod === 0);
+      await settle(page);
+      const tag = `${mode}_texture_${target}`;
+      const plain = await shoot(page, '#model-canvas', `${tag}_plain.png`);
+      await page.check('#shared-texture');
+      await settle(page);
+      const textured = await shoot(page, '#model-canvas', `${tag}_textured.png`);
+      await page.check('#on-sphere');
+      await settle(page);
+      const sphere = await shoot(page, '#model-canvas', `${tag}_sphere.png`);
+      await page.uncheck('#on-sphere');
+      await page.uncheck('#shared-texture');
+      await page.click('#lod-buttons button[data-lod="auto"]');
+      await settle(page);
+      r.textures.push({ model: target, coverage_plain: coverage(plain), coverage_textured: coverage(textured),
+                        changed_fraction: changedFraction(plain, textured), coverage_sphere: coverage(sphere),
+                        sphere_changed_fraction: changedFraction(textured, sphere),
+                        shots: [`${tag}_plain.png`, `${tag}_textured.png`, `${tag}_sphere.png`] });
+    }
   }
   const morphs = await page.evaluate(() => window.spherekitViewer ? window.spherekitViewer.morphs.length : 0);
   for (let k = 0; k < morphs && !(await failed()); k++) {

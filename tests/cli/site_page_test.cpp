@@ -354,6 +354,17 @@ TEST_CASE("run without meshes: the main job on the built-in samples, its outputs
     // "auto": the finest level when framed, a coarser one once zoomed out.
     CHECK(m.at("auto_lod").at("before") == 0);
     CHECK(m.at("auto_lod").at("after_zoom_out").get<int>() > 0);
+    // The shared texture on every member and on all of them side by side: the grid changes a
+    // good part of each model's pixels against the grey render; each model on its sphere
+    // covers the canvas too and differs from the model.
+    REQUIRE(m.at("textures").size() == members + (members > 1 ? 1 : 0));
+    for (const auto& t : m["textures"]) {
+      INFO("texture on model " << t.at("model"));
+      CHECK(t.at("coverage_plain").get<double>() > 0.02);
+      CHECK(t.at("changed_fraction").get<double>() > 0.3 * t.at("coverage_plain").get<double>());
+      CHECK(t.at("coverage_sphere").get<double>() > 0.02);
+      CHECK(t.at("sphere_changed_fraction").get<double>() > 0.01);
+    }
     REQUIRE(m.at("morphs").size() == 3);  // members as targets, the morph, the PCA
     for (const auto& morph : m["morphs"]) {
       CHECK(morph.at("targets").get<int>() >= 1);

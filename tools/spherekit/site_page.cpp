@@ -370,13 +370,21 @@ Status write_site_page(const std::string& out_dir, const Json& site, std::vector
               "<div class=\"toolbar\"><label>model <select id=\"model-select\">";
       for (std::size_t i = 0; i < model_names.size(); ++i)
         body += "<option value=\"" + std::to_string(i) + "\">" + html(model_names[i]) + "</option>";
+      if (model_names.size() > 1) body += "<option value=\"all\">all, side by side</option>";
       body += "</select></label><span id=\"lod-buttons\"></span>"
-              "<label><input type=\"checkbox\" id=\"wireframe\"> wireframe</label></div>\n"
+              "<label><input type=\"checkbox\" id=\"wireframe\"> wireframe</label>"
+              "<label title=\"one labelled grid over the octahedral geometry-image domain (TEXCOORD_0): the same "
+              "cell is the same sphere point, and in a consistent collection the same feature, on every model\">"
+              "<input type=\"checkbox\" id=\"shared-texture\"> shared texture</label>"
+              "<label title=\"each model on its sphere: the sphere point of every vertex, from TEXCOORD_0\">"
+              "<input type=\"checkbox\" id=\"on-sphere\"> on its sphere</label></div>\n"
               "<div class=\"canvas-box\" id=\"model-canvas\"></div>\n"
               "<p class=\"status\" id=\"model-status\">loading the 3-D view...</p>\n"
               "<noscript><p class=\"note\">The 3-D view needs JavaScript.</p></noscript>\n"
               "<p class=\"status\">Drag to turn, scroll to zoom, right-drag to pan. LOD 0 is the finest level; "
-              "\"auto\" picks coarser levels as the model gets smaller on screen.</p></div></section>\n";
+              "\"auto\" picks coarser levels as the model gets smaller on screen. \"shared texture\" paints one grid "
+              "through the common domain: in a consistent collection each cell lands on the same part of every "
+              "model (compare them with \"all, side by side\").</p></div></section>\n";
     }
     if (morphs_3d) {
       add_nav("morphs", "morphs");

@@ -229,9 +229,94 @@ inline constexpr const char* kSiteViewerJs = R"SPHEREKIT_JS(// SphereKit results
     return this.camera.position.distanceTo(this.controls.target) / this.fitDistance;
   };
 
-  function surfaceMaterial(wireframe) {
+  function surfaceMaterial(wireframe, map) {
     return new THREE.MeshStandardMaterial({
-      color: 0xc9ced6, roughness: 0.55, metalness: 0.0, side: THREE.DoubleSide, wireframe: wireframe
+      color: map ? 0xffffff : 0xc9ced6, roughness: 0.55, metalness: 0.0, side: THREE.DoubleSide,
+      wireframe: wireframe, map: map || null
+    });
+  }
+
+  // ---- The shared domain made visible (issue 22). Every level of detail carries TEXCOORD_0,
+  // the texel centre of its vertex in the octahedral geometry image, which is the same sphere
+  // point, and in a consistent collection the same feature, on every member. One labelled grid
+  // over that square on every member shows the correspondence.
+  var gridTexture = null;
+  function sharedGrid() {
+    if (gridTexture) return gridTexture;
+    var cells = 8, size = 1024, step = size / cells;
+    var canvas = document.createElement('canvas');
+    canvas.width = canvas.height = size;
+    var g = canvas.getContext('2d');
+    for (var r = 0; r < cells; r++)
+      for (var c = 0; c < cells; c++) {
+        g.fillStyle = 'hsl(' + Math.round(((r * 3 + c * 5) % cells) * 360 / cells) + ',' + ((r + c) % 2 ? 70 : 45) + '%,' +
+          ((r + c) % 2 ? 62 : 42) + '%)';
+        g.fillRect(c * step, r * step, step, step);
+        g.fillStyle = (r + c) % 2 ? '#111' : '#fff';
+        g.font = 'bold ' + Math.round(step * 0.42) + 'px sans-serif';
+        g.textAlign = 'center';
+        g.textBaseline = 'middle';
+        // Drawn upside down: seen from outside, the octahedral square's t axis runs up the
+        // central diamond, so the labels read upright there.
+        g.save();
+        g.translate((c + 0.5) * step, (r + 0.5) * step);
+        g.scale(1, -1);
+        g.fillText(String.fromCharCode(65 + r) + (c + 1), 0, 0);
+        g.restore();
+      }
+    g.strokeStyle = '#000';
+    g.lineWidth = 3;
+    for (var k = 0; k <= cells; k++) {
+      g.beginPath(); g.moveTo(k * step, 0); g.lineTo(k * step, size); g.stroke();
+      g.beginPath(); g.moveTo(0, k * step); g.lineTo(size, k * step); g.stroke();
+    }
+    gridTexture = new THREE.CanvasTexture(canvas);
+    gridTexture.flipY = false;  // glTF texture coordinates: (0, 0) is the image's top-left
+    gridTexture.colorSpace = THREE.SRGBColorSpace;
+    gridTexture.anisotropy = 4;
+    return gridTexture;
+  }
+
+  // The sphere point of a geometry-image texture coordinate: texel centre s = (j + 1/2) / T ->
+  // octahedral u = -1 + 2j / (T-1) (gltf_mesh.h), then the octahedral unfolding
+  // (geometry_image.h, octahedral_to_sphere).
+  function octahedralToSphere(u, v, out) {
+    var z = 1 - Math.abs(u) - Math.abs(v), x = u, y = v;
+    if (z < 0) {
+      x = (1 - Math.abs(v)) * (u < 0 ? -1 : 1);
+      y = (1 - Math.abs(u)) * (v < 0 ? -1 : 1);
+    }
+    return out.set(x, y, z).normalize();
+  }
+  // Shows each mesh of `root` on its sphere (on) or as itself (off): the sphere of the mesh's
+  // bounding radius about its centre, positions from TEXCOORD_0. Meshes without it stay.
+  var shapes = new WeakMap();  // geometry -> {surface, sphere} attributes (clones share geometry)
+  function onSphere(root, on) {
+    root.traverse(function (o) {
+      if (!o.isMesh || !o.geometry.attributes.uv) return;
+      var geo = o.geometry, d = shapes.get(geo);
+      if (!d) {
+        d = {};
+        shapes.set(geo, d);
+        d.surface = { position: geo.attributes.position, normal: geo.attributes.normal };
+        geo.computeBoundingSphere();
+        var uv = geo.attributes.uv, lo = Infinity;
+        for (var i = 0; i < uv.count; i++) lo = Math.min(lo, uv.getX(i), uv.getY(i));
+        var T = 0.5 / lo, c = geo.boundingSphere.center, radius = geo.boundingSphere.radius * 0.8;
+        var pos = new Float32Array(uv.count * 3), nor = new Float32Array(uv.count * 3), p = new THREE.Vector3();
+        for (var k = 0; k < uv.count; k++) {
+          var j = uv.getX(k) * T - 0.5, r = uv.getY(k) * T - 0.5;
+          octahedralToSphere(-1 + 2 * j / (T - 1), -1 + 2 * r / (T - 1), p);
+          nor[3 * k] = p.x; nor[3 * k + 1] = p.y; nor[3 * k + 2] = p.z;
+          pos[3 * k] = c.x + radius * p.x; pos[3 * k + 1] = c.y + radius * p.y; pos[3 * k + 2] = c.z + radius * p.z;
+        }
+        d.sphere = { position: new THREE.BufferAttribute(pos, 3), normal: new THREE.BufferAttribute(nor, 3) };
+      }
+      var use = on ? d.sphere : d.surface;
+      geo.setAttribute('position', use.position);
+      if (use.normal) geo.setAttribute('normal', use.normal);
+      geo.computeBoundingSphere();
+      geo.computeBoundingBox();
     });
   }
   // The files carry no material (glTF's default is a fully metallic one, black without an
@@ -260,8 +345,16 @@ inline constexpr const char* kSiteViewerJs = R"SPHEREKIT_JS(// SphereKit results
     if (!box || !models.length) return;
     var view = new View(box);
     var select = byId('model-select'), bar = byId('lod-buttons'), wire = byId('wireframe');
-    var solid = surfaceMaterial(false), lines = surfaceMaterial(true);
+    var texture = byId('shared-texture'), sphere = byId('on-sphere');
+    var materials = {};
+    function material() {
+      var key = (wire && wire.checked ? 'w' : 's') + (state.textured ? 't' : '');
+      if (!materials[key]) materials[key] = surfaceMaterial(key[0] === 'w', state.textured ? sharedGrid() : null);
+      return materials[key];
+    }
     var levels = [], counts = [], token = 0, name = '';
+    state.textured = !!(texture && texture.checked);
+    state.sphere = !!(sphere && sphere.checked);
 
     // Auto: level k from 2^(k-1/2) times the framing distance on (each level halves the grid,
     // so it is chosen when the model covers about half as many pixels).
@@ -303,34 +396,64 @@ inline constexpr const char* kSiteViewerJs = R"SPHEREKIT_JS(// SphereKit results
         bar.appendChild(b);
       });
     }
+    function loadModel(model) {
+      return Promise.all(model.lods.map(function (lod) { return loadGlb(lod).then(parseGlb); }))
+        .then(function (gltfs) { return gltfs.map(function (g) { return g.scene; }); });
+    }
+    // index: a model, or 'all': every model side by side in a row, level k of each in level k
+    // (a model with fewer levels shows its coarsest).
     function show(index) {
-      var model = models[index], mine = ++token;
+      var all = index === 'all', chosen = all ? models : [models[index]], mine = ++token;
+      var label = all ? 'all ' + models.length + ' models' : chosen[0].name;
       state.model = index;
       state.pending++;
-      setText(status, 'loading ' + model.name + '...');
-      Promise.all(model.lods.map(function (lod) { return loadGlb(lod).then(parseGlb); }))
-        .then(function (gltfs) {
+      setText(status, 'loading ' + label + '...');
+      Promise.all(chosen.map(loadModel))
+        .then(function (perModel) {
           if (mine !== token) return;
-          var group = new THREE.Group();
-          levels = gltfs.map(function (g) { return g.scene; });
+          var group = new THREE.Group(), n = 0;
+          perModel.forEach(function (ls) { n = Math.max(n, ls.length); });
+          levels = [];
+          for (var k = 0; k < n; k++) levels.push(new THREE.Group());
+          var x = 0;
+          perModel.forEach(function (ls) {
+            ls.forEach(function (l) { restyle(l, material()); onSphere(l, state.sphere); });
+            var size = new THREE.Box3().setFromObject(ls[0]).getSize(new THREE.Vector3());
+            var center = new THREE.Box3().setFromObject(ls[0]).getCenter(new THREE.Vector3());
+            for (var k = 0; k < n; k++) {
+              var l = k < ls.length ? ls[k] : ls[ls.length - 1].clone();
+              if (all) l.position.set(x + size.x / 2 - center.x, -center.y, -center.z);
+              levels[k].add(l);
+            }
+            x += size.x * 1.15;
+          });
           counts = levels.map(triangles);
-          levels.forEach(function (l) { restyle(l, wire && wire.checked ? lines : solid); group.add(l); });
-          name = model.name;
+          levels.forEach(function (l) { group.add(l); });
+          name = label;
           state.levels = levels.length;
           state.lod = -1;
           view.show(group);
           view.frame(levels[0]);
           buildButtons();
         })
-        .catch(function (e) { fail(status, model.name, e); })
+        .catch(function (e) { fail(status, label, e); })
         .then(function () { state.pending--; });
     }
-    if (select) select.addEventListener('change', function () { show(Number(select.value)); });
-    if (wire) wire.addEventListener('change', function () {
-      levels.forEach(function (l) { restyle(l, wire.checked ? lines : solid); });
+    function selected() { return !select ? 0 : select.value === 'all' ? 'all' : Number(select.value); }
+    if (select) select.addEventListener('change', function () { show(selected()); });
+    function restyleAll() {
+      levels.forEach(function (l) { restyle(l, material()); });
+      view.requestRender();
+    }
+    if (wire) wire.addEventListener('change', restyleAll);
+    if (texture) texture.addEventListener('change', function () { state.textured = texture.checked; restyleAll(); });
+    if (sphere) sphere.addEventListener('change', function () {
+      state.sphere = sphere.checked;
+      levels.forEach(function (l) { onSphere(l, state.sphere); });
+      if (levels.length) view.frame(levels[0]);
       view.requestRender();
     });
-    show(select ? Number(select.value) : 0);
+    show(selected());
   }
 
   // ---- Morph targets: "sequence" (successive frames, one slider) or "weights" (one slider each).

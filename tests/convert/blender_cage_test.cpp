@@ -97,6 +97,13 @@ BlenderCageResult blender_round_trip(const std::string& mesh_path, const std::st
   RemeshErrorOptions opts;
   opts.samples = samples;
   out.psnr_blender = remesh_error(original.value(), evaluated.value(), opts).psnr;
+  // The same number from the command a user runs on Blender's export.
+  const CliRun e = sk("eval-surface " + q(mesh_path) + " " + q(prefix + "_blender.obj") + " --samples " +
+                          std::to_string(samples) + " --json",
+                      cap);
+  INFO(e.err);
+  REQUIRE(e.exit_code == 0);
+  CHECK(nlohmann::json::parse(e.out)["psnr_db"].get<double>() == Approx(out.psnr_blender).epsilon(1e-12));
 
   // Our displaced surface, rebuilt from the written files alone (cage OBJ + texture).
   auto cage_mesh = formats::read_mesh(prefix + "_cage.obj");

@@ -217,3 +217,27 @@ TEST_CASE("convert --collection: one layout for every member, features on the sa
   CHECK_FALSE(fs::exists(out + "/sample_a_cage.obj"));
   CHECK(read_json(out + "/convert_report.json")["size"] == 17);
 }
+
+TEST_CASE("eval-surface measures two surfaces with convert's remesh_error", "[convert][cli]") {
+  const std::string dir = test::temp_dir("eval_surface_cli"), cap = test::temp_dir("eval_surface_capture");
+  const TriMesh blob = test::random_blob(3, 7);
+  TriMesh round = blob;
+  round.V = blob.V.rowwise().normalized();
+  REQUIRE(formats::write_mesh(dir + "/blob.obj", blob).ok());
+  REQUIRE(formats::write_mesh(dir + "/round.obj", round).ok());
+  const CliRun r = sk("eval-surface " + q(dir + "/blob.obj") + " " + q(dir + "/round.obj") + " --samples 20000 --json", cap);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const json j = json::parse(r.out);
+  RemeshErrorOptions opts;
+  opts.samples = 20000;
+  const RemeshError e = remesh_error(blob, round, opts);
+  CHECK(j["psnr_db"].get<double>() == Approx(e.psnr).epsilon(1e-12));
+  CHECK(j["rms_forward"].get<double>() == Approx(e.rms_forward).epsilon(1e-12));
+  CHECK(j["peak"].get<double>() == Approx(e.peak).epsilon(1e-12));
+  // A missing file: one line naming it, I/O exit code.
+  const CliRun bad = sk("eval-surface " + q(dir + "/blob.obj") + " " + q(dir + "/none.obj"), cap);
+  CHECK(bad.exit_code == 4);
+  CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
+  CHECK(bad.err.find("none.obj") != std::string::npos);
+}

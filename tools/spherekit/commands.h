@@ -19,6 +19,7 @@ namespace spherekit::cli {
 void register_check(CLI::App& app);    // cmd_check.cpp:   mesh report, pinched-vertex repair
 void register_param(CLI::App& app);    // cmd_param.cpp:   unconstrained spherical parameterization
 void register_eval(CLI::App& app);     // cmd_eval.cpp:    measures of any sphere map (= evalsphere.py)
+void register_eval_surface(CLI::App& app);  // cmd_eval_surface.cpp: distance/PSNR of two surfaces (remesh_error)
 void register_samples(CLI::App& app);  // cmd_samples.cpp: writes the built-in sample collection
 void register_bench(CLI::App& app);    // cmd_bench.cpp:   per-mesh time/memory/efficiency vs. the reference
 void register_run(CLI::App& app);      // cmd_run.cpp:     the main job: check + param + eval + report

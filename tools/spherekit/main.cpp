@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   cli::register_check(app);
   cli::register_param(app);
   cli::register_eval(app);
+  cli::register_eval_surface(app);
   cli::register_samples(app);
   cli::register_bench(app);
   cli::register_run(app);

@@ -12,4 +12,4 @@ bash "$root/scripts/build.sh"
 # three.js and the Draco decoder for the results page's 3-D view (npm): optional, without them
 # index.html shows everything else and says why.
 bash "$root/scripts/setup_viewer.sh" >/dev/null || true
-exec "$root/build/tools/spherekit/spherekit" run "$@"
+exec "$root/build/tools/cli/spherekit" run "$@"

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -434,6 +435,35 @@ Status require_genus0(const MeshCheck& check, bool allow_boundary) {
   const std::string problem = first_problem(check, allow_boundary);
   if (problem.empty()) return Status::ok_status();
   return Status(ErrorCode::InvalidInput, problem);
+}
+
+Status require_supported_coordinates(const TriMesh& mesh) {
+  if (mesh.V.rows() == 0) return Status::ok_status();
+  char text[200];
+  const double largest = mesh.V.cwiseAbs().maxCoeff();
+  if (!(largest <= kMaxCoordinate)) {
+    std::snprintf(text, sizeof text,
+                  "coordinates reach %.3g, beyond the supported |x| <= %.0e (lengths, areas and stretch would "
+                  "overflow); scale the mesh down",
+                  largest, kMaxCoordinate);
+    return Status(ErrorCode::InvalidInput, text);
+  }
+  // No overflow below kMaxCoordinate: the diagonal is at most 2 sqrt(3) kMaxCoordinate.
+  const double extent = (mesh.V.colwise().maxCoeff() - mesh.V.colwise().minCoeff()).norm();
+  if (extent == 0) return Status(ErrorCode::InvalidInput, "all vertices are at one point (zero extent)");
+  if (extent < kMinExtent) {
+    std::snprintf(text, sizeof text,
+                  "the mesh is %.3g across, below the supported %.0e (areas and stretch would underflow); scale "
+                  "the mesh up",
+                  extent, kMinExtent);
+    return Status(ErrorCode::InvalidInput, text);
+  }
+  return Status::ok_status();
+}
+
+Status require_param_accepts(const TriMesh& mesh, const MeshCheck& check, bool allow_boundary) {
+  SPHEREKIT_RETURN_IF_ERROR(require_genus0(check, allow_boundary));
+  return require_supported_coordinates(mesh);
 }
 
 }  // namespace spherekit

@@ -58,8 +58,11 @@ ConstrainedParamResult as_constrained(const SphereParamResult& r) {
 Status constrained_maps(const std::vector<TriMesh>& meshes, const std::vector<std::vector<int>>& features,
                         const std::vector<int>& which, const std::vector<Eigen::Vector3d>& targets,
                         const ConsistentParamOptions& options, const std::string& stage, const ProgressFn& progress,
-                        std::vector<ConstrainedParamResult>* out) {
-  return detail::run_parallel_jobs(
+                        std::vector<ConstrainedParamResult>* out, MeshFailure* failure) {
+  // Each job's own error, so that the failing mesh is known as a value: run_parallel_jobs
+  // returns the lowest-numbered job's real failure.
+  std::vector<Status> reasons(which.size());
+  const Status s = detail::run_parallel_jobs(
       static_cast<int>(which.size()), options.threads, stage, progress,
       [&](int j, int threads, const std::function<bool()>& keep_going) -> Status {
         const int i = which[static_cast<size_t>(j)];
@@ -67,12 +70,20 @@ Status constrained_maps(const std::vector<TriMesh>& meshes, const std::vector<st
         o.sphere.threads = threads;  // effort only: same bits for any count
         auto r = parameterize_sphere_constrained(meshes[static_cast<size_t>(i)], features[static_cast<size_t>(i)],
                                                  targets, o, [&](const ProgressEvent&) { return keep_going(); });
-        if (!r.ok()) return r.status().with_context(mesh_label(i));
-        if (r->flipped_faces != 0)  // never expected: the stage checks; a guard for the collection
-          return Status(ErrorCode::Internal, mesh_label(i) + ": constrained map has flipped faces");
+        if (!r.ok()) reasons[static_cast<size_t>(j)] = r.status();
+        else if (r->flipped_faces != 0)  // never expected: the stage checks; a guard for the collection
+          reasons[static_cast<size_t>(j)] = Status(ErrorCode::Internal, "constrained map has flipped faces");
+        if (!reasons[static_cast<size_t>(j)].ok()) return reasons[static_cast<size_t>(j)].with_context(mesh_label(i));
         (*out)[static_cast<size_t>(i)] = std::move(r).value();
         return Status();
       });
+  if (!s.ok() && s.code() != ErrorCode::Cancelled)
+    for (size_t j = 0; j < which.size(); ++j)
+      if (!reasons[j].ok() && reasons[j].code() != ErrorCode::Cancelled) {
+        *failure = {which[j], reasons[j]};
+        break;
+      }
+  return s;
 }
 
 // Replaces the positions of the `hole` vertices by the harmonic interpolation (uniform
@@ -180,7 +191,15 @@ std::vector<int> snap_texels(const std::vector<Eigen::Vector3d>& locations, int 
 Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>& meshes,
                                                       const std::vector<std::vector<int>>& features,
                                                       const ConsistentParamOptions& options,
-                                                      const ProgressFn& progress) {
+                                                      const ProgressFn& progress, MeshFailure* failure_out) {
+  MeshFailure unused;
+  MeshFailure& failure = failure_out ? *failure_out : unused;
+  failure = MeshFailure{};
+  // An error of mesh i: the value for the caller, the message naming it for everyone else.
+  auto fail_mesh = [&](int i, const Status& reason) {
+    failure = {i, reason};
+    return reason.with_context(mesh_label(i));
+  };
   const auto t_start = std::chrono::steady_clock::now();
   const int n = static_cast<int>(meshes.size());
   if (n < 1) return Status(ErrorCode::InvalidArgument, "no meshes");
@@ -191,9 +210,12 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   if (k < 1) return Status(ErrorCode::InvalidArgument, "no features");
   for (int i = 1; i < n; ++i)
     if (features[static_cast<size_t>(i)].size() != k)
-      return Status(ErrorCode::InvalidArgument, mesh_label(i) + " has " +
-                                                    std::to_string(features[static_cast<size_t>(i)].size()) +
-                                                    " features, " + mesh_label(0) + " has " + std::to_string(k));
+    {
+      const std::string counts = std::to_string(features[static_cast<size_t>(i)].size()) + " features, " +
+                                 mesh_label(0) + " has " + std::to_string(k);
+      failure = {i, Status(ErrorCode::InvalidArgument, "has " + counts)};
+      return Status(ErrorCode::InvalidArgument, mesh_label(i) + " has " + counts);
+    }
   const int ref = options.reference;
   if (ref < 0 || ref >= n)
     return Status(ErrorCode::InvalidArgument, "reference " + std::to_string(ref) + " is not a mesh index (0.." +
@@ -207,9 +229,9 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   for (int i = 0; i < n; ++i)
     for (int v : features[static_cast<size_t>(i)])
       if (v < 0 || v >= meshes[static_cast<size_t>(i)].V.rows())
-        return Status(ErrorCode::InvalidInput, mesh_label(i) + ": feature vertex " + std::to_string(v) +
-                                                   " out of range (mesh has " +
-                                                   std::to_string(meshes[static_cast<size_t>(i)].V.rows()) + ")");
+        return fail_mesh(i, Status(ErrorCode::InvalidInput,
+                                   "feature vertex " + std::to_string(v) + " out of range (mesh has " +
+                                       std::to_string(meshes[static_cast<size_t>(i)].V.rows()) + ")"));
 
   ConsistentParamResult result;
   result.maps.resize(static_cast<size_t>(n));
@@ -220,7 +242,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   auto t0 = std::chrono::steady_clock::now();
   {
     auto r = parameterize_sphere(meshes[static_cast<size_t>(ref)], sphere, prefixed(progress, "step 1"));
-    if (!r.ok()) return r.status().with_context(mesh_label(ref));
+    if (!r.ok()) return fail_mesh(ref, r.status());
     for (int v : features[static_cast<size_t>(ref)]) result.initial_locations.push_back(r->map.S.row(v).transpose());
     result.reference_efficiency = r->efficiency;
     result.maps[static_cast<size_t>(ref)] = as_constrained(r.value());
@@ -234,7 +256,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   for (int i = 0; i < n; ++i)
     if (i != ref) others.push_back(i);
   SPHEREKIT_RETURN_IF_ERROR(constrained_maps(meshes, features, others, result.initial_locations, options, "step 2",
-                                             progress, &result.maps));
+                                             progress, &result.maps, &failure));
   result.times.initial = seconds_since(t0);
   result.final_locations = result.initial_locations;
   if (!options.refine_locations || n < 2) {
@@ -252,7 +274,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
       return Status(ErrorCode::Cancelled, "cancelled");
     auto g = remesh_on_grid(meshes[static_cast<size_t>(i)], result.maps[static_cast<size_t>(i)].map.S,
                             features[static_cast<size_t>(i)], texels, grid, options.threads);
-    if (!g.ok()) return g.status().with_context(mesh_label(i));
+    if (!g.ok()) return fail_mesh(i, g.status());
     remesh[static_cast<size_t>(i)] = std::move(g).value();
   }
   result.times.remesh = seconds_since(t0);
@@ -318,17 +340,21 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   std::vector<int> all;
   for (int i = 0; i < n; ++i) all.push_back(i);
   std::vector<ConstrainedParamResult> final_maps(static_cast<size_t>(n));
-  const Status s6 =
-      constrained_maps(meshes, features, all, result.final_locations, options, "step 6", progress, &final_maps);
+  MeshFailure failure6;
+  const Status s6 = constrained_maps(meshes, features, all, result.final_locations, options, "step 6", progress,
+                                     &final_maps, &failure6);
   if (s6.ok()) {
     result.maps = std::move(final_maps);
   } else if (s6.code() == ErrorCode::SolverFailed) {
     // One mesh cannot be mapped to F: the step-2 maps are a complete, consistent answer (all
     // features on F'), so keep them rather than fail the collection, and say so.
     result.refinement_failure = s6.message();
+    result.refinement_failure_mesh = failure6.mesh;
+    result.refinement_failure_reason = failure6.reason.message();
     result.rejected_locations = result.final_locations;
     result.final_locations = result.initial_locations;
   } else {
+    failure = failure6;
     return s6;
   }
   result.times.final_maps = seconds_since(t0);

@@ -280,9 +280,12 @@ int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<ch
 namespace {
 constexpr const char* kSteinerFailure = "a face stays flipped after removing the path network's Steiner vertices";
 
+// `steiner_failure` is set when the attempt failed only because a face stayed flipped after
+// the Steiner vertices were removed: the one failure another network variant may avoid.
 Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const std::vector<int>& feature_vertices,
                                                    const std::vector<Eigen::Vector3d>& targets_in,
-                                                   const ConstrainedParamOptions& options, const ProgressFn& progress) {
+                                                   const ConstrainedParamOptions& options, const ProgressFn& progress,
+                                                   bool* steiner_failure) {
   const auto t_start = std::chrono::steady_clock::now();
   ConstrainedParamResult result;
   const SphereParamOptions& so = options.sphere;
@@ -313,7 +316,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
 
   // 1. Check and close holes (as the unconstrained stage does).
   MeshCheck check = check_mesh(mesh);
-  SPHEREKIT_RETURN_IF_ERROR(require_genus0(check, /*allow_boundary=*/true));
+  SPHEREKIT_RETURN_IF_ERROR(require_param_accepts(mesh, check, /*allow_boundary=*/true));
   SPHEREKIT_ASSIGN_OR_RETURN(FilledMesh filled, fill_holes(mesh));
   result.holes_filled = filled.holes;
   const TriMesh& closed = filled.mesh;
@@ -513,8 +516,10 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     for (int v : fv) fixed_net[static_cast<size_t>(v)] = 1;
     RowMat3d Sw = Snet;
     int untangled = remove_steiner_vertices(net, fixed_net, &Sw);
-    if (untangled < 0)
+    if (untangled < 0) {
+      *steiner_failure = true;
       return Status(ErrorCode::SolverFailed, kSteinerFailure);
+    }
     result.network.flips_after_steiner_removal = untangled;
     S = Sw.topRows(n);
     if (int flips = count_flipped_faces(closed.F, S); flips != 0)
@@ -548,14 +553,15 @@ Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& me
   for (double f : factors) {
     ConstrainedParamOptions o = options;
     o.steiner_penalty = std::max(1.05, options.steiner_penalty * f);
-    Result<ConstrainedParamResult> r = constrained_attempt(mesh, feature_vertices, targets, o, progress);
+    bool steiner_failure = false;
+    Result<ConstrainedParamResult> r = constrained_attempt(mesh, feature_vertices, targets, o, progress, &steiner_failure);
     ++attempt;
     if (r.ok()) {
       r.value().network.attempts = attempt;
       return r;
     }
     last = r.status();
-    if (last.code() != ErrorCode::SolverFailed || last.message() != kSteinerFailure) return last;
+    if (!steiner_failure) return last;
   }
   return Status(ErrorCode::SolverFailed, std::string(kSteinerFailure) + " (after " + std::to_string(attempt) + " network variants)");
 }

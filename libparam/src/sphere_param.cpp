@@ -59,7 +59,7 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
 
   // 1. Refuse what we cannot map (one precise message).
   MeshCheck check = check_mesh(mesh);
-  SPHEREKIT_RETURN_IF_ERROR(require_genus0(check, /*allow_boundary=*/true));
+  SPHEREKIT_RETURN_IF_ERROR(require_param_accepts(mesh, check, /*allow_boundary=*/true));
   result.times.check = seconds_since(t_start);
 
   // 2. Close holes with tagged low-weight faces (removed again from the output).

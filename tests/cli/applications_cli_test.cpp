@@ -26,16 +26,9 @@ using spherekit::test::slurp;
 
 namespace {
 
-bool is_png(const std::string& path) { return slurp(path).rfind("\x89PNG\r\n\x1a\n", 0) == 0; }
+using spherekit::test::require_failure;
 
-/// A failed command: the expected exit code and one error line naming `what`.
-void require_failure(const CliRun& r, int code, const std::string& what) {
-  INFO("stdout: " << r.out << "\nstderr: " << r.err);
-  CHECK(r.exit_code == code);
-  CHECK(r.err.rfind("spherekit: error: ", 0) == 0);
-  CHECK(r.err.find(what) != std::string::npos);
-  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
-}
+bool is_png(const std::string& path) { return slurp(path).rfind("\x89PNG\r\n\x1a\n", 0) == 0; }
 
 }  // namespace
 

@@ -13,15 +13,20 @@
 
 #include "cli_runner.h"
 #include "test_paths.h"
+#include "test_files.h"
+#include "cli_shorthands.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using spherekit::test::files_in;
+using spherekit::test::quote;
+using spherekit::test::require_failure;
+using spherekit::test::write_text;
+
 using spherekit::test::CliRun;
 using spherekit::test::slurp;
-
-std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
 
 CliRun run_cli(const std::string& args, const std::string& capture_dir) {
   return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
@@ -29,18 +34,6 @@ CliRun run_cli(const std::string& args, const std::string& capture_dir) {
 
 /// A corpus file.
 std::string bad(const std::string& name) { return std::string(SPHEREKIT_SOURCE_DIR) + "/tests/data/bad/" + name; }
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-std::vector<std::string> files_in(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
 
 /// An output folder holding one existing file per output kind, each with known contents: a
 /// failing command must neither replace them nor create anything beside them.
@@ -69,19 +62,6 @@ struct OutputDir {
     }
   }
 };
-
-int count_lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
-
-/// The failure contract: the exit code, one stderr line starting `spherekit: error: ` that
-/// names `file` (its file name) and contains `problem`.
-void require_failure(const CliRun& r, int exit_code, const std::string& file, const std::string& problem) {
-  INFO("stderr: " << r.err);
-  CHECK(r.exit_code == exit_code);
-  CHECK(count_lines(r.err) == 1);
-  CHECK(r.err.rfind("spherekit: error: ", 0) == 0);
-  CHECK(r.err.find(fs::path(file).filename().string()) != std::string::npos);
-  CHECK(r.err.find(problem) != std::string::npos);
-}
 
 /// A mesh file every command must refuse.
 struct MeshCase {

@@ -13,15 +13,16 @@
 
 #include "cli_runner.h"
 #include "test_paths.h"
+#include "cli_shorthands.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
 
-using spherekit::test::slurp;
-std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
+using spherekit::test::quote;
 
+using spherekit::test::slurp;
 // Runs a shell command with stdout captured to `out_file` (stderr to out_file + ".err");
 // returns the exit code.
 int run(const std::string& cmd, const std::string& out_file) {

@@ -19,6 +19,8 @@
 #include "spherekit/version.h"
 #include "test_meshes.h"
 #include "test_paths.h"
+#include "test_files.h"
+#include "cli_shorthands.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -26,19 +28,16 @@ using spherekit::TriMesh;
 
 namespace {
 
+using spherekit::test::files_in;
+using spherekit::test::quote;
+using spherekit::test::write_text;
+
 using spherekit::test::CliRun;
 using spherekit::test::slurp;
-std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
-
 // Runs `spherekit ARGS` with stdout/stderr captured into files of `capture_dir` (never the
 // folder whose contents a test inspects).
 CliRun run_cli(const std::string& args, const std::string& capture_dir) {
   return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
 }
 
 std::string obj_text(const TriMesh& m) {
@@ -82,13 +81,6 @@ std::string binary_ply(const TriMesh& m, long header_vertices) {
     }
   }
   return s;
-}
-
-std::vector<std::string> files_in(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 int count_lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }

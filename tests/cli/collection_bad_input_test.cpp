@@ -23,6 +23,7 @@
 #include "cli_runner.h"
 #include "cli_shorthands.h"
 #include "test_paths.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -34,10 +35,8 @@ using spherekit::test::slurp;
 
 namespace {
 
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-}
+using spherekit::test::require_failure;
+using spherekit::test::write_text;
 
 // Every file of a folder (names, including hidden temporary files) with its bytes.
 std::map<std::string, std::string> snapshot(const std::string& dir) {
@@ -57,16 +56,6 @@ std::string joined(const std::vector<std::string>& lines) {
   std::string out;
   for (const std::string& l : lines) out += l + "\n";
   return out;
-}
-
-// The failure contract (as in bad_input_test.cpp).
-void require_failure(const CliRun& r, int exit_code, const std::string& file, const std::string& problem) {
-  INFO("stderr: " << r.err);
-  CHECK(r.exit_code == exit_code);
-  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
-  CHECK(r.err.rfind("spherekit: error: ", 0) == 0);
-  CHECK(r.err.find(file) != std::string::npos);
-  CHECK(r.err.find(problem) != std::string::npos);
 }
 
 /// What a command must say about a broken folder.

@@ -15,6 +15,7 @@
 #include "cli_runner.h"
 #include "cli_shorthands.h"
 #include "test_paths.h"
+#include "test_files.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -25,6 +26,8 @@ using spherekit::test::sk;
 using spherekit::test::slurp;
 
 namespace {
+
+using spherekit::test::files_in;
 
 // The smallest useful built-in collection: two members of ~600 vertices, sample_b with a
 // hole (hole filling and its weights take part). Small keeps the test near 10 s in Release.
@@ -70,13 +73,6 @@ void require_has_timings(const std::string& path) {
   const json j = read_json(path);
   CHECK(j.contains("times"));
   CHECK(j.contains("cpu_seconds"));
-}
-
-std::vector<std::string> files_in(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
 }
 
 void require_same_bytes(const std::string& a, const std::string& b) {

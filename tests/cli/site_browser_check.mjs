@@ -1,5 +1,5 @@
 // node site_browser_check.mjs NODE_DIR PAGE_DIR SHOT_DIR
-// Opens PAGE_DIR/index.html (the results page, tools/spherekit/site_page.h) in Debian's headless
+// Opens PAGE_DIR/index.html (the results page, pipeline/include/spherekit/pipeline/site_page.h) in Debian's headless
 // Chromium through playwright-core, twice: served by a local HTTP server on 127.0.0.1, and from
 // disk (file://). Each time it records console errors and warnings, page errors and failed
 // requests, waits until the viewer has loaded everything (window.spherekitViewer.pending == 0),

@@ -15,16 +15,17 @@
 #include "spherekit/formats/sphere_map_io.h"
 #include "test_meshes.h"
 #include "test_paths.h"
+#include "cli_shorthands.h"
 
 namespace fs = std::filesystem;
 using namespace spherekit;
 
 namespace {
 
+using spherekit::test::quote;
+
 using spherekit::test::CliRun;
 using spherekit::test::slurp;
-std::string quote(const std::string& s) { return spherekit::test::shell_quote(s); }
-
 CliRun run_cli(const std::string& args, const std::string& capture_dir) {
   return spherekit::test::run_cli(SPHEREKIT_EXE, args, capture_dir);
 }

@@ -10,13 +10,14 @@
 #include "cli_runner.h"
 #include "gltf_test_support.h"
 #include "test_paths.h"
+#include "cli_shorthands.h"
 
 namespace fs = std::filesystem;
 using namespace spherekit;
 
 namespace {
 
-std::string quote_arg(const std::string& s) { return test::shell_quote(s); }
+using spherekit::test::quote;
 
 }  // namespace
 
@@ -24,9 +25,9 @@ TEST_CASE("spherekit convert --lods writes Draco glTF levels and reports their s
   const std::string dir = test::temp_dir("convert_cli_gltf"), cap = test::temp_dir("convert_cli_gltf_capture");
   test::write_blob_inputs(dir);
   const test::CliRun r = test::run_cli(SPHEREKIT_EXE,
-                                       "convert " + quote_arg(dir + "/blob.obj") + " " + quote_arg(dir + "/blob.sphere.obj") +
-                                           " -o " + quote_arg(dir + "/blob.exr") + " --gi 33 --lods 3 --report " +
-                                           quote_arg(dir + "/blob.json") + " --psnr-samples 20000",
+                                       "convert " + quote(dir + "/blob.obj") + " " + quote(dir + "/blob.sphere.obj") +
+                                           " -o " + quote(dir + "/blob.exr") + " --gi 33 --lods 3 --report " +
+                                           quote(dir + "/blob.json") + " --psnr-samples 20000",
                                        cap);
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
@@ -65,8 +66,8 @@ TEST_CASE("spherekit convert: --lods that do not fit --gi are a usage error and 
   const std::string dir = test::temp_dir("convert_cli_gltf_bad"), cap = test::temp_dir("convert_cli_gltf_bad_capture");
   test::write_blob_inputs(dir);
   const test::CliRun r = test::run_cli(SPHEREKIT_EXE,
-                                       "convert " + quote_arg(dir + "/blob.obj") + " " + quote_arg(dir + "/blob.sphere.obj") +
-                                           " -o " + quote_arg(dir + "/blob.exr") + " --gi 33 --lods 6",
+                                       "convert " + quote(dir + "/blob.obj") + " " + quote(dir + "/blob.sphere.obj") +
+                                           " -o " + quote(dir + "/blob.exr") + " --gi 33 --lods 6",
                                        cap);
   CHECK(r.exit_code == 2);
   CHECK(r.err.rfind("spherekit: error: ", 0) == 0);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "spherekit/check_mesh.h"
+#include "spherekit/sphere_param.h"
 #include "test_meshes.h"
 #include "test_paths.h"
 
@@ -379,4 +380,30 @@ TEST_CASE("check_mesh matches manifest.json on every shared mesh", "[param][chec
     CHECK(c.bbox_diag == Approx(want["bbox_diag"].get<double>()).epsilon(1e-5));
     CHECK(c.genus0_ok() == want["genus0_ok"].get<bool>());
   }
+}
+
+TEST_CASE("require_param_accepts: one verdict for the stages and the command line", "[param][check]") {
+  TriMesh m = test::octahedron();
+  CHECK(require_param_accepts(m, check_mesh(m)).ok());
+  struct Case {
+    double scale;
+    const char* problem;
+  };
+  for (const Case c : {Case{1e300, "coordinates reach 1e+300"}, Case{1e-60, "below the supported 1e-50"},
+                       Case{0.0, "all vertices are at one point"}}) {
+    INFO("scale " << c.scale);
+    TriMesh scaled = m;
+    scaled.V *= c.scale;
+    const Status verdict = require_param_accepts(scaled, check_mesh(scaled));
+    REQUIRE(verdict.code() == ErrorCode::InvalidInput);
+    CHECK(verdict.message().find(c.problem) != std::string::npos);
+    // The stage refuses with the same verdict (not NaN measures).
+    auto mapped = parameterize_sphere(scaled, SphereParamOptions{});
+    REQUIRE_FALSE(mapped.ok());
+    CHECK(mapped.status().message() == verdict.message());
+  }
+  // Topology first: a torus is refused for its genus whatever its size.
+  TriMesh torus = test::torus();
+  torus.V *= 1e300;
+  CHECK(require_param_accepts(torus, check_mesh(torus)).message() == require_genus0(check_mesh(torus)).message());
 }

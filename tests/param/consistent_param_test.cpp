@@ -203,19 +203,27 @@ TEST_CASE("consistent parameterization refuses bad arguments with a clear error"
   {
     auto f = features;
     f[1][0] = static_cast<int>(meshes[1].V.rows());
-    auto r = parameterize_consistent(meshes, f, o);
+    MeshFailure failure;
+    auto r = parameterize_consistent(meshes, f, o, {}, &failure);
     REQUIRE_FALSE(r.ok());
     CHECK(r.status().code() == ErrorCode::InvalidInput);
     CHECK(r.status().message().find("mesh 1") != std::string::npos);
+    // The same as a value: which mesh, and why without the label.
+    CHECK(failure.mesh == 1);
+    CHECK(failure.reason.code() == ErrorCode::InvalidInput);
+    CHECK(r.status().message() == "mesh 1: " + failure.reason.message());
   }
   {
     // Two features on one vertex of mesh 1: the constrained stage's error, naming the mesh.
     auto f = features;
     f[1][1] = f[1][0];
-    auto r = parameterize_consistent(meshes, f, o);
+    MeshFailure failure;
+    auto r = parameterize_consistent(meshes, f, o, {}, &failure);
     REQUIRE_FALSE(r.ok());
     CHECK(r.status().code() == ErrorCode::InvalidInput);
     CHECK(r.status().message().find("mesh 1") != std::string::npos);
+    CHECK(failure.mesh == 1);  // found in a parallel job: still the mesh, as a value
+    CHECK(r.status().message() == "mesh 1: " + failure.reason.message());
   }
   ConsistentParamOptions bad = o;
   bad.reference = 3;

@@ -1,5 +1,5 @@
 // libFuzzer harness: a collection folder's manifest (collection.json) and feature list
-// (features.txt), as every collection command reads them (tools/spherekit/collection.h). The
+// (features.txt), as every collection command reads them (spherekit/formats/collection.h). The
 // input is split at its first NUL byte: manifest before, features.txt after (no NUL: no
 // features.txt). The reader takes a folder, so both are written into a scratch folder of this
 // process. Contract: errors are one line naming a file of the folder; on success every
@@ -14,8 +14,8 @@
 #include <set>
 #include <string>
 
-#include "collection.h"
 #include "fuzz_common.h"
+#include "spherekit/formats/collection.h"
 
 namespace {
 
@@ -46,21 +46,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     std::filesystem::remove(dir + "/features.txt", ec);
   else
     put(dir + "/features.txt", all.substr(nul + 1));
-  Result<cli::CollectionInfo> info = cli::read_collection(dir);
+  Result<formats::Collection> info = formats::read_collection(dir);
   if (!info.ok()) {
     fuzz::require(!info.status().message().empty());
     fuzz::require(info.status().message().find('\n') == std::string::npos);
     fuzz::require(info.status().message().rfind(dir, 0) == 0);
     return 0;
   }
-  fuzz::require(!info->feature_names.empty());
-  fuzz::require(info->feature_names.size() == info->locations.size());
-  std::set<std::string> names(info->feature_names.begin(), info->feature_names.end());
-  fuzz::require(names.size() == info->feature_names.size());
-  for (const Eigen::Vector3d& p : info->locations) fuzz::require(p.allFinite() && std::abs(p.norm() - 1) < 1e-6);
-  for (const cli::Json& m : info->manifest["meshes"]) {
-    const std::string map = m["map"].get<std::string>();
-    fuzz::require(!map.empty() && map.find('/') == std::string::npos && map != "." && map != "..");
-  }
+  const formats::CollectionManifest& m = info->manifest;
+  fuzz::require(!m.features.empty());
+  const std::vector<std::string> feature_names = m.feature_names();
+  std::set<std::string> names(feature_names.begin(), feature_names.end());
+  fuzz::require(names.size() == feature_names.size());
+  for (const Eigen::Vector3d& p : m.locations()) fuzz::require(p.allFinite() && std::abs(p.norm() - 1) < 1e-6);
+  for (const formats::CollectionMember& e : m.members)
+    fuzz::require(!e.map.empty() && e.map.find('/') == std::string::npos && e.map != "." && e.map != "..");
+  // Written back and read again, a manifest is the same manifest.
+  auto again = formats::parse_collection_manifest(formats::collection_manifest_text(m), "again");
+  fuzz::require(again.ok());
+  fuzz::require(formats::collection_manifest_text(again.value()) == formats::collection_manifest_text(m));
   return 0;
 }

@@ -103,6 +103,27 @@ MeshCheck check_mesh(const TriMesh& mesh);
 /// handle them (see kZeroAreaRelTolerance).
 Status require_genus0(const MeshCheck& check, bool allow_boundary = true);
 
+/// Coordinates parameterization accepts: every |x| <= kMaxCoordinate and a bounding-box
+/// diagonal >= kMinExtent. Beyond these, squared lengths, cross products and areas of the mesh
+/// overflow or underflow in double precision (|x| = 1e300 makes every area inf, 1e-100 makes
+/// it 0), so stretch and quality numbers come out NaN or 0 while everything else looks fine.
+/// 1e50 leaves room for the 4th and higher powers of lengths the stretch computation forms.
+inline constexpr double kMaxCoordinate = 1e50;
+inline constexpr double kMinExtent = 1e-50;
+
+/// InvalidInput if the mesh's coordinates are outside the range above (or all vertices
+/// coincide); Ok otherwise (and for a mesh without vertices). Coordinates must be finite
+/// (require_genus0 refuses others first).
+Status require_supported_coordinates(const TriMesh& mesh);
+
+/// What spherical parameterization accepts, as one verdict: require_genus0(check,
+/// allow_boundary), then require_supported_coordinates(mesh). Every stage that maps a mesh
+/// (parameterize_sphere, parameterize_sphere_constrained, parameterize_consistent) refuses
+/// with it, and `spherekit check`, `param`, `convert`, `consistent` and `add` judge with it,
+/// so a library user and the command line get the same verdict. `check` must be
+/// check_mesh(mesh).
+Status require_param_accepts(const TriMesh& mesh, const MeshCheck& check, bool allow_boundary = true);
+
 /// Splits every non-manifold ("pinched") vertex into one vertex per face fan. New vertices
 /// are appended at the end with the same position; `new_to_old` (if given) receives, for
 /// each appended vertex, the vertex it was split from. Returns the number of splits.

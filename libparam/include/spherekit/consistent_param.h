@@ -70,8 +70,19 @@ struct ConsistentParamResult {
   /// then falls back to the step-2 maps (every feature on F', still consistent) and this
   /// holds the reason; `rejected_locations` holds the F that was tried.
   std::string refinement_failure;
+  /// The same as values: the mesh that could not be mapped to F, and why (without the
+  /// "mesh i: " of refinement_failure); -1 and empty when step 6 succeeded.
+  int refinement_failure_mesh = -1;
+  std::string refinement_failure_reason;
   std::vector<Eigen::Vector3d> rejected_locations;
   ConsistentParamTimes times;
+};
+
+/// Which mesh an error of parameterize_consistent() concerns, as a value: callers name the
+/// mesh their way (its file, its member name) without reading the message.
+struct MeshFailure {
+  int mesh = -1;  ///< index into `meshes`; -1: the collection as a whole (sizes, options)
+  Status reason;  ///< the error without the "mesh i: " the returned Status starts with
 };
 
 /// Maps n >= 1 meshes consistently. `features[i][k]` is the vertex of mesh i that is
@@ -79,11 +90,12 @@ struct ConsistentParamResult {
 /// a path network without auxiliary features, see parameterize_sphere_constrained).
 /// Errors name the mesh ("mesh 2: ..."): InvalidArgument (sizes, options), InvalidInput (a
 /// mesh not genus 0, two features on one vertex, ...), SolverFailed (a path network could
-/// not be completed), Cancelled.
+/// not be completed), Cancelled. `failure`, when given, receives which mesh an error
+/// concerns and why.
 /// Deterministic: same input and options give the same bits, for any thread count.
 Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>& meshes,
                                                       const std::vector<std::vector<int>>& features,
                                                       const ConsistentParamOptions& options = {},
-                                                      const ProgressFn& progress = {});
+                                                      const ProgressFn& progress = {}, MeshFailure* failure = nullptr);
 
 }  // namespace spherekit

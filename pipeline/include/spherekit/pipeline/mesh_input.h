@@ -1,0 +1,37 @@
+// Reading a mesh with its structural check, and the verdict whether param accepts it, as
+// `check`, `param` and every job use them.
+#pragma once
+
+#include <string>
+
+#include "spherekit/check_mesh.h"
+#include "spherekit/formats/mesh_io.h"
+#include "spherekit/mesh.h"
+#include "spherekit/status.h"
+
+namespace spherekit::pipeline {
+
+/// A mesh as read from disk, with its structural check.
+struct LoadedMesh {
+  std::string path;
+  TriMesh mesh;
+  MeshCheck check;
+  formats::ReadInfo info;
+  int split_vertices = 0;  ///< vertices added by repair_pinched_vertices (repair = true)
+  double read_seconds = 0, check_seconds = 0;
+};
+
+/// Reads and checks a mesh without judging it (for `check`). The error message starts
+/// with the file path.
+Result<LoadedMesh> load_mesh(const std::string& path);
+
+/// What `param` accepts: the library's one verdict (require_param_accepts, check_mesh.h) with
+/// the message starting with the file path.
+Status param_verdict(const LoadedMesh& mesh, bool allow_boundary);
+
+/// Reads a mesh, optionally splits pinched vertices, checks it and refuses anything the
+/// parameterizer cannot handle (param_verdict). `allow_boundary`: holes are acceptable.
+/// The error message starts with the file path.
+Result<LoadedMesh> load_mesh_checked(const std::string& path, bool allow_boundary, bool repair);
+
+}  // namespace spherekit::pipeline

@@ -1,0 +1,317 @@
+// make_collection() and add_to_collection() (collection.h): the consistent parameterization
+// of a collection into its folder, and a new member mapped onto an existing collection's
+// feature locations.
+#include <algorithm>
+#include <cstdarg>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "sample_collection.h"
+#include "spherekit/check_mesh.h"
+#include "spherekit/file_status.h"
+#include "spherekit/formats/atomic_file.h"
+#include "spherekit/formats/feature_io.h"
+#include "spherekit/formats/mesh_io.h"
+#include "spherekit/formats/sphere_map_io.h"
+#include "spherekit/pipeline/collection.h"
+#include "spherekit/pipeline/json.h"
+#include "spherekit/version.h"
+#include "stopwatch.h"
+#include "text.h"
+
+namespace fs = std::filesystem;
+
+namespace spherekit::pipeline {
+namespace {
+
+using detail::format_text;
+
+// A map may enter a collection only if it is a bijection with every feature on its location.
+Status require_exact(const ConstrainedParamResult& r, const std::string& label) {
+  if (r.flipped_faces != 0)
+    return Status(ErrorCode::SolverFailed,
+                  format_text("%s: the map has %d flipped faces (not bijective)", label.c_str(), r.flipped_faces));
+  if (!(r.max_feature_angle < 1e-9))
+    return Status(ErrorCode::Internal, format_text("%s: a feature is %.3g rad off its location", label.c_str(), r.max_feature_angle));
+  return Status();
+}
+
+// Feature vertices of a mesh in the order of `names`, from its landmark file.
+Result<std::vector<int>> features_in_order(const std::string& lm_path, int vertices,
+                                           const std::vector<std::string>& names) {
+  auto lms = formats::read_landmarks(lm_path, vertices);
+  if (!lms.ok()) return with_file(lms.status(), lm_path);
+  std::vector<int> fv;
+  for (const std::string& name : names) {
+    auto it = std::find_if(lms->begin(), lms->end(), [&](const Landmark& l) { return l.name == name; });
+    if (it == lms->end())
+      return Status(ErrorCode::InvalidInput, format_text("%s: no feature '%s' (the collection needs every one of its %zu features)",
+                                                         lm_path.c_str(), name.c_str(), names.size()));
+    fv.push_back(it->vertex);
+  }
+  return fv;
+}
+
+std::string default_features_path(const std::string& mesh) {
+  const fs::path p(mesh);
+  return (p.parent_path() / (p.stem().string() + ".lm.txt")).string();
+}
+
+std::string absolute_path(const std::string& p) {
+  std::error_code ec;
+  return fs::weakly_canonical(fs::absolute(p, ec), ec).string();
+}
+
+// A mesh param accepts (the one verdict, check_mesh.h); errors name the file.
+Result<TriMesh> read_accepted_mesh(const std::string& path) {
+  auto mesh = formats::read_mesh(path);
+  if (!mesh.ok()) return with_file(mesh.status(), path);
+  SPHEREKIT_RETURN_IF_ERROR(with_file(require_param_accepts(mesh.value(), check_mesh(mesh.value())), path));
+  return mesh;
+}
+
+// The members: the given meshes with their feature files, or the built-in samples.
+Status read_members(const MakeCollectionJob& a, MakeCollectionResult& out) {
+  std::vector<CollectionInput>& members = out.members;
+  std::vector<std::string>& names = out.feature_names;  // in the first member's order
+  if (a.meshes.empty()) {
+    SPHEREKIT_ASSIGN_OR_RETURN(auto samples, samples::make_sample_collection());
+    for (const auto& s : samples) {
+      CollectionInput m;
+      m.name = s.name;
+      m.source = "builtin:" + s.name;
+      m.features_file = "builtin";
+      m.mesh = s.mesh;
+      if (names.empty())
+        for (const Landmark& l : s.landmarks) names.push_back(l.name);
+      for (const Landmark& l : s.landmarks) m.feature_vertices.push_back(l.vertex);
+      members.push_back(std::move(m));
+    }
+    return Status();
+  }
+  std::set<std::string> stems;
+  for (size_t i = 0; i < a.meshes.size(); ++i) {
+    const std::string& path = a.meshes[i];
+    CollectionInput m;
+    m.name = fs::path(path).stem().string();
+    if (!stems.insert(m.name).second)
+      return Status(ErrorCode::InvalidArgument,
+                    path + ": another input has the same file name stem '" + m.name + "' (sphere maps are named after it)");
+    SPHEREKIT_ASSIGN_OR_RETURN(m.mesh, read_accepted_mesh(path));
+    m.source = absolute_path(path);
+    m.features_file = a.features.empty() ? default_features_path(path) : a.features[i];
+    const int nv = static_cast<int>(m.mesh.V.rows());
+    if (names.empty()) {
+      auto lms = formats::read_landmarks(m.features_file, nv);
+      if (!lms.ok()) return with_file(lms.status(), m.features_file);
+      if (lms->empty()) return Status(ErrorCode::InvalidInput, m.features_file + ": no features");
+      for (const Landmark& l : lms.value()) names.push_back(l.name);
+    }
+    SPHEREKIT_ASSIGN_OR_RETURN(m.feature_vertices, features_in_order(m.features_file, nv, names));
+    // Extra features of later members would be silently ignored: refuse them instead.
+    auto all = formats::read_landmarks(m.features_file, nv);
+    if (all.ok() && all->size() != names.size())
+      return Status(ErrorCode::InvalidInput,
+                    format_text("%s: has %zu features, %s has %zu (feature files must name the same features)",
+                                m.features_file.c_str(), all->size(),
+                                members.empty() ? "it" : members[0].features_file.c_str(), names.size()));
+    members.push_back(std::move(m));
+  }
+  return Status();
+}
+
+formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const ConsistentParamOptions& o,
+                                        const std::string& refinement_failure) {
+  const ConsistentParamResult& r = out.maps;
+  formats::CollectionManifest man;
+  man.library_version = kVersion;
+  man.method = o.refine_locations ? "consistent (steps 1-6)" : "consistent (steps 1-2: reference locations)";
+  man.reference = out.members[static_cast<size_t>(out.reference)].name;
+  for (size_t k = 0; k < out.feature_names.size(); ++k)
+    man.features.push_back({out.feature_names[k], r.final_locations[k], r.initial_locations[k]});
+  for (size_t i = 0; i < out.members.size(); ++i) {
+    const CollectionInput& m = out.members[i];
+    formats::CollectionMember e;
+    e.name = m.name;
+    e.source = m.source;
+    e.features_file = m.features_file == "builtin" ? m.features_file : absolute_path(m.features_file);
+    e.map = m.name + ".sphere.obj";
+    e.vertices = m.mesh.V.rows();
+    e.faces = m.mesh.F.rows();
+    e.feature_vertices = std::vector<long long>(m.feature_vertices.begin(), m.feature_vertices.end());
+    e.added = false;
+    e.result = map_entry_json(r.maps[i]);
+    man.members.push_back(std::move(e));
+  }
+  man.options = constrained_options_json(o.constrained);
+  man.options["remesh_size"] = o.remesh_size;
+  man.options["refine_locations"] = o.refine_locations;
+  if (!refinement_failure.empty()) {
+    man.method = "consistent (steps 1-2: reference locations; step 6 failed)";
+    man.extra["refinement_failure"] = refinement_failure;
+    Json rejected = Json::array();
+    for (const auto& p : r.rejected_locations) rejected.push_back(Json::array({p.x(), p.y(), p.z()}));
+    man.extra["rejected_locations"] = rejected;
+  }
+  man.extra["steps"] = Json{{"reference_efficiency", r.reference_efficiency},
+                            {"joint_efficiency", r.joint_efficiency},
+                            {"joint_flipped_faces", r.joint_flips},
+                            {"remesh_vertices", r.remesh_vertices}};
+  man.extra["times"] = Json{{"step1_reference", r.times.reference}, {"step2_initial_maps", r.times.initial},
+                            {"step3_remesh", r.times.remesh},       {"step4_concatenate", r.times.concatenate},
+                            {"step5_joint_map", r.times.joint},     {"step6_final_maps", r.times.final_maps},
+                            {"total", r.times.total}};
+  return man;
+}
+
+}  // namespace
+
+Json map_entry_json(const ConstrainedParamResult& r) {
+  Json j;
+  j["efficiency"] = r.efficiency;
+  j["l2_stretch"] = r.l2_stretch;
+  j["linf_stretch"] = r.linf_stretch;
+  j["flipped_faces"] = r.flipped_faces;
+  j["winding"] = r.winding;
+  j["max_feature_angle"] = r.max_feature_angle;
+  j["holes_filled"] = r.holes_filled;
+  j["method"] = r.map.provenance.method;
+  j["network"] = feature_network_json(r.network);
+  j["times"] = Json{{"network", r.times.network}, {"simplify", r.times.simplify},
+                    {"refine", r.times.refine},   {"total", r.times.total}};
+  return j;
+}
+
+Result<MakeCollectionResult> make_collection(const MakeCollectionJob& a, const ProgressFn& progress,
+                                             const formats::KeepGoingFn& keep_going) {
+  Stopwatch wall;
+  SPHEREKIT_RETURN_IF_ERROR(formats::require_staged_folder_target(a.output, formats::kCollectionManifest));
+  if (!a.features.empty() && a.features.size() != a.meshes.size())
+    return Status(ErrorCode::InvalidArgument,
+                  format_text("%zu meshes but %zu --features files (give one per mesh, in order, or none)",
+                              a.meshes.size(), a.features.size()));
+  MakeCollectionResult out;
+  SPHEREKIT_RETURN_IF_ERROR(read_members(a, out));
+  if (!a.reference.empty()) {
+    out.reference = -1;
+    for (size_t i = 0; i < out.members.size(); ++i)
+      if (out.members[i].name == a.reference || a.reference == std::to_string(i)) out.reference = static_cast<int>(i);
+    if (out.reference < 0)
+      return Status(ErrorCode::InvalidArgument, "--reference '" + a.reference + "' is neither a mesh's file stem nor an index");
+  }
+  ConsistentParamOptions o = a.options;
+  o.reference = out.reference;
+  std::vector<TriMesh> meshes;
+  std::vector<std::vector<int>> features;
+  for (const CollectionInput& m : out.members) {
+    meshes.push_back(m.mesh);
+    features.push_back(m.feature_vertices);
+  }
+  MeshFailure failure;
+  auto result = parameterize_consistent(meshes, features, o, progress, &failure);
+  if (!result.ok()) {
+    // The mesh by its file, not by its index.
+    if (failure.mesh < 0) return result.status();
+    return with_file(failure.reason, out.members[static_cast<size_t>(failure.mesh)].source);
+  }
+  out.maps = std::move(result).value();
+  const ConsistentParamResult& r = out.maps;
+  for (size_t i = 0; i < out.members.size(); ++i)
+    if (Status s = require_exact(r.maps[i], out.members[i].source);
+        !s.ok() && !(static_cast<int>(i) == out.reference && !o.refine_locations))
+      return s;
+  if (!r.refinement_failure.empty())
+    out.refinement_warning = r.refinement_failure_mesh < 0 ? r.refinement_failure
+                                                           : out.members[static_cast<size_t>(r.refinement_failure_mesh)].name +
+                                                                 ": " + r.refinement_failure_reason;
+  out.manifest = manifest_of(out, o, out.refinement_warning);
+  SPHEREKIT_RETURN_IF_ERROR(formats::write_staged_folder(
+      a.output, formats::kCollectionManifest,
+      [&](const std::string& dir) -> Status {
+        for (size_t i = 0; i < out.members.size(); ++i)
+          SPHEREKIT_RETURN_IF_ERROR(formats::write_sphere_map(
+              (fs::path(dir) / (out.members[i].name + ".sphere.obj")).string(), out.members[i].mesh, r.maps[i].map));
+        SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic((fs::path(dir) / formats::kCollectionFeatures).string(),
+                                                             formats::sphere_points_text(out.feature_names, r.final_locations)));
+        return formats::write_file_atomic((fs::path(dir) / formats::kCollectionManifest).string(),
+                                          formats::collection_manifest_text(out.manifest));
+      },
+      keep_going));
+  out.wall_seconds = wall.seconds();
+  return out;
+}
+
+Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, const ProgressFn& progress) {
+  Stopwatch wall;
+  SPHEREKIT_ASSIGN_OR_RETURN(formats::Collection c, formats::read_collection(a.dir));
+  SPHEREKIT_ASSIGN_OR_RETURN(TriMesh mesh, read_accepted_mesh(a.mesh));
+  AddToCollectionResult out;
+  out.name = a.name.empty() ? fs::path(a.mesh).stem().string() : a.name;
+  const std::string& name = out.name;
+  // The map is written as DIR/<name>.sphere.obj: a name with a path would put it elsewhere
+  // (and make the manifest unreadable, see read_collection).
+  if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos)
+    return Status(ErrorCode::InvalidArgument, "--name '" + name + "': must be a plain file name");
+  const int existing = c.manifest.member_index(name);
+  if (existing >= 0 && !a.replace)
+    return Status(ErrorCode::InvalidArgument, a.mesh + ": the collection already has a mesh named '" + name +
+                                                  "' (use --name, or --replace to map it again)");
+  // Never grow a broken collection: every other member's map must be there and fit.
+  SPHEREKIT_RETURN_IF_ERROR(formats::check_member_maps(c, existing));
+  const std::string lm = a.features.empty() ? default_features_path(a.mesh) : a.features;
+  const int nv = static_cast<int>(mesh.V.rows());
+  SPHEREKIT_ASSIGN_OR_RETURN(std::vector<int> fv, features_in_order(lm, nv, c.manifest.feature_names()));
+
+  ConstrainedParamOptions o = a.options;
+  // The collection's shape-defining settings, unless given here.
+  const Json& opt = c.manifest.options;
+  if (opt.is_object() && opt.contains("seed") && opt["seed"].is_number_unsigned() && !a.seed_given)
+    o.sphere.seed = opt["seed"].get<std::uint64_t>();
+  auto result = parameterize_sphere_constrained(mesh, fv, c.manifest.locations(), o, progress);
+  if (!result.ok()) return with_file(result.status(), a.mesh);
+  out.map = std::move(result).value();
+  SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
+
+  formats::CollectionMember e;
+  e.name = name;
+  e.source = absolute_path(a.mesh);
+  e.features_file = absolute_path(lm);
+  e.map = name + ".sphere.obj";
+  e.vertices = nv;
+  e.faces = mesh.F.rows();
+  e.feature_vertices = std::vector<long long>(fv.begin(), fv.end());
+  e.added = true;
+  e.result = map_entry_json(out.map);
+  out.manifest = c.manifest;
+  if (existing >= 0)
+    out.manifest.members[static_cast<size_t>(existing)] = std::move(e);
+  else
+    out.manifest.members.push_back(std::move(e));
+  // The map first, then the manifest that names it: a reader never sees a member without
+  // its map. If the manifest cannot be written, the map is put back as it was (--replace:
+  // the old one, which the manifest still describes; otherwise none).
+  out.map_path = (fs::path(a.dir) / (name + ".sphere.obj")).string();
+  const bool map_existed = fs::exists(out.map_path);
+  std::string old_map;
+  if (map_existed) {
+    SPHEREKIT_ASSIGN_OR_RETURN(old_map, formats::read_file(out.map_path));
+  }
+  SPHEREKIT_RETURN_IF_ERROR(formats::write_sphere_map(out.map_path, mesh, out.map.map));
+  if (Status s = formats::write_file_atomic((fs::path(a.dir) / formats::kCollectionManifest).string(),
+                                            formats::collection_manifest_text(out.manifest));
+      !s.ok()) {
+    std::error_code ec;
+    if (map_existed)
+      (void)formats::write_file_atomic(out.map_path, old_map);
+    else
+      fs::remove(out.map_path, ec);
+    return s;
+  }
+  out.vertices = nv;
+  out.features = c.manifest.features.size();
+  out.wall_seconds = wall.seconds();
+  return out;
+}
+
+}  // namespace spherekit::pipeline

@@ -1,0 +1,42 @@
+// Mesh input with its check and verdict (mesh_input.h).
+#include "spherekit/pipeline/mesh_input.h"
+
+#include "spherekit/file_status.h"
+#include "stopwatch.h"
+
+namespace spherekit::pipeline {
+
+Result<LoadedMesh> load_mesh(const std::string& path) {
+  LoadedMesh out;
+  out.path = path;
+  Stopwatch read_time;
+  auto mesh = formats::read_mesh(path, formats::ReadOptions{}, &out.info);
+  if (!mesh.ok()) return with_file(mesh.status(), path);
+  out.mesh = std::move(mesh).value();
+  out.read_seconds = read_time.seconds();
+  Stopwatch check_time;
+  out.check = check_mesh(out.mesh);
+  out.check_seconds = check_time.seconds();
+  return out;
+}
+
+Result<LoadedMesh> load_mesh_checked(const std::string& path, bool allow_boundary, bool repair) {
+  auto loaded = load_mesh(path);
+  if (!loaded.ok()) return loaded.status();
+  LoadedMesh& m = loaded.value();
+  if (repair && m.check.nonmanifold_vertices > 0) {
+    Stopwatch t;
+    m.split_vertices = repair_pinched_vertices(m.mesh);
+    m.check = check_mesh(m.mesh);
+    m.check_seconds += t.seconds();
+  }
+  Status verdict = param_verdict(m, allow_boundary);
+  if (!verdict.ok()) return verdict;
+  return loaded;
+}
+
+Status param_verdict(const LoadedMesh& m, bool allow_boundary) {
+  return with_file(require_param_accepts(m.mesh, m.check, allow_boundary), m.path);
+}
+
+}  // namespace spherekit::pipeline

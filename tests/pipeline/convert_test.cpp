@@ -1,0 +1,145 @@
+// The conversion pipeline as a library (spherekit/pipeline/convert.h), not through the
+// program: one mesh with its sphere map, the refusals that leave nothing written, and a
+// collection converted into one folder whose members share one layout.
+#include <catch2/catch.hpp>
+#include <filesystem>
+
+#include "spherekit/formats/atomic_file.h"
+#include "spherekit/formats/collection.h"
+#include "spherekit/formats/mesh_io.h"
+#include "spherekit/formats/sphere_map_io.h"
+#include "spherekit/pipeline/convert.h"
+#include "test_files.h"
+#include "test_meshes.h"
+#include "test_paths.h"
+
+namespace fs = std::filesystem;
+using namespace spherekit;
+
+namespace {
+
+// A bumpy genus-0 mesh and its radial projection, a bijective sphere map.
+struct MappedMesh {
+  TriMesh mesh;
+  SphereMap map;
+};
+
+MappedMesh blob(std::uint64_t seed) {
+  MappedMesh m;
+  m.mesh = test::random_blob(2, seed);
+  m.map.S = m.mesh.V.rowwise().normalized();
+  return m;
+}
+
+std::string write_pair(const std::string& dir, const std::string& name, const MappedMesh& m) {
+  REQUIRE(formats::write_mesh(dir + "/" + name + ".obj", m.mesh).ok());
+  REQUIRE(formats::write_sphere_map(dir + "/" + name + ".sphere.obj", m.mesh, m.map).ok());
+  return dir + "/" + name;
+}
+
+pipeline::ConvertOptions small_options() {
+  pipeline::ConvertOptions o;
+  o.size = 17;
+  o.psnr_samples = 2000;
+  o.lods = 2;
+  o.cage = 1;
+  o.cage_tile = 3;
+  return o;
+}
+
+
+}  // namespace
+
+TEST_CASE("convert_mesh: image, previews, levels of detail, cage, measured and reported", "[pipeline]") {
+  const std::string dir = test::temp_dir("pipeline_convert_mesh");
+  const std::string base = write_pair(dir, "blob", blob(3));
+  pipeline::ConvertMeshJob job{base + ".obj", base + ".sphere.obj", dir + "/out/blob.exr", dir + "/out/blob.gim.obj",
+                               small_options()};
+  fs::create_directories(dir + "/out");
+  auto r = pipeline::convert_mesh(job);
+  REQUIRE(r.ok());
+  CHECK(test::files_in(dir + "/out") == std::vector<std::string>{"blob.exr", "blob.gim.obj", "blob_cage.obj", "blob_disp.exr",
+                                                           "blob_lod0.glb", "blob_lod1.glb", "blob_lods.glb",
+                                                           "blob_normals.png", "blob_positions.png"});
+  const pipeline::GeometryAssets& g = r->assets;
+  CHECK(g.image.size == 17);
+  CHECK(g.remesh.F.rows() == 2 * 16 * 16);  // closed mesh: no holes to leave open
+  REQUIRE(g.measured);
+  CHECK(g.error.psnr > 20);
+  CHECK_FALSE(g.error_all_faces.has_value());
+  REQUIRE(g.lod_errors.size() == 2);
+  CHECK(g.lod_errors[1].psnr < g.lod_errors[0].psnr + 1e-9);  // the coarser level is no closer
+  REQUIRE(g.cage.has_value());
+  CHECK(g.cage->quads == 6);
+  const pipeline::Json j = pipeline::to_json(r.value());
+  CHECK(j["size"] == 17);
+  CHECK(j["positions"] == "fit");
+  CHECK(j["lods"].size() == 2);
+  CHECK(j["cage"]["displacement"] == "scalar");
+  CHECK(j["cage"]["bytes"].get<long long>() > 0);
+  CHECK(j["psnr_db"].get<double>() == Approx(g.error.psnr));
+}
+
+TEST_CASE("convert_mesh: refused input writes nothing and names the file", "[pipeline]") {
+  const std::string dir = test::temp_dir("pipeline_convert_refused");
+  MappedMesh folded = blob(5);
+  folded.map.S.row(0) *= -1;  // one vertex to the antipode: faces flip
+  const std::string base = write_pair(dir, "folded", folded);
+  fs::create_directories(dir + "/out");
+  auto r = pipeline::convert_mesh({base + ".obj", base + ".sphere.obj", dir + "/out/x.exr", "", small_options()});
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.status().code() == ErrorCode::InvalidInput);
+  CHECK(r.status().message().rfind(base + ".sphere.obj: not a bijective sphere map", 0) == 0);
+  CHECK(test::files_in(dir + "/out").empty());
+  pipeline::ConvertOptions bad = small_options();
+  bad.size = 20;
+  CHECK(pipeline::check_convert_options(bad).message().find("--size 20") != std::string::npos);
+  bad = small_options();
+  bad.lods = 5;
+  CHECK(pipeline::check_convert_options(bad).message().find("--lods 5 does not fit") != std::string::npos);
+}
+
+TEST_CASE("convert_collection: every member into one folder with one layout and a morph glTF", "[pipeline]") {
+  const std::string dir = test::temp_dir("pipeline_convert_collection");
+  const std::string col = dir + "/col";
+  fs::create_directories(col);
+  formats::CollectionManifest m;
+  m.features.push_back({"north", Eigen::Vector3d(0, 0, 1), std::nullopt});
+  for (int k = 0; k < 2; ++k) {
+    const std::string name = "m" + std::to_string(k);
+    const MappedMesh x = blob(10 + static_cast<std::uint64_t>(k));
+    REQUIRE(formats::write_mesh(dir + "/" + name + ".obj", x.mesh).ok());
+    REQUIRE(formats::write_sphere_map(col + "/" + name + ".sphere.obj", x.mesh, x.map).ok());
+    formats::CollectionMember e;
+    e.name = name;
+    e.map = name + ".sphere.obj";
+    e.source = dir + "/" + name + ".obj";
+    e.vertices = x.mesh.V.rows();
+    m.members.push_back(e);
+  }
+  REQUIRE(formats::write_file_atomic(col + "/features.txt", formats::sphere_points_text({"north"}, m.locations())).ok());
+  REQUIRE(formats::write_file_atomic(col + "/collection.json", formats::collection_manifest_text(m)).ok());
+
+  int events = 0;
+  auto r = pipeline::convert_collection({col, dir + "/assets", small_options()}, [&](const ProgressEvent&) {
+    ++events;
+    return true;
+  });
+  REQUIRE(r.ok());
+  CHECK(events > 0);
+  REQUIRE(r->members.size() == 2);
+  // One connectivity: the members' remeshes are the same faces.
+  CHECK(r->members[0].assets.remesh.F == r->members[1].assets.remesh.F);
+  const auto names = test::files_in(dir + "/assets");
+  CHECK(std::count(names.begin(), names.end(), "collection_morph.glb") == 1);
+  CHECK(std::count(names.begin(), names.end(), "convert_report.json") == 1);
+  CHECK(formats::read_file(dir + "/assets/convert_report.json").value() == r->report.dump(2) + "\n");
+  CHECK(r->report["members"][1]["cage"]["file"] == "m1_cage.obj");
+  CHECK(r->report["feature_texels"][0]["name"] == "north");
+
+  SECTION("cancelled between members: the folder is not replaced") {
+    auto again = pipeline::convert_collection({col, dir + "/assets", small_options()}, {}, [] { return false; });
+    CHECK(again.status().code() == ErrorCode::Cancelled);
+    CHECK(test::files_in(dir + "/assets") == names);
+  }
+}

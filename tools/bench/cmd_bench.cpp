@@ -1,0 +1,323 @@
+// `spherekit bench`: time, peak memory and efficiency of `param` per mesh, side by side
+// with the reference implementation's figures (shared/docs/EVALUATION.md §4).
+//
+// Each mesh runs in a child process (`spherekit param ... --report`), so CPU time and peak
+// resident memory are the mesh's own, measured by the kernel (wait4), not accumulated over
+// the whole benchmark or hidden by an allocator that keeps freed memory.
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <thread>
+#include <string>
+#include <vector>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "sample_collection.h"
+#include "spherekit/formats/atomic_file.h"
+#include "spherekit/version.h"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+
+namespace spherekit::cli {
+namespace {
+
+// Praun & Hoppe's SphereParam at default effort on a 2-core machine (EVALUATION.md §4):
+// evaluator efficiency (holes: real faces only), total CPU seconds (PM + SP), peak MB.
+struct Reference {
+  const char* file;
+  double efficiency;
+  double cpu_seconds;
+  double peak_mb;
+};
+constexpr Reference kReference[] = {
+    {"knight.obj", 0.3095, 4.2, 5},        {"woody.obj", 0.9151, 3.5, 6},      {"spot.obj", 0.7182, 5.2, 10},
+    {"max_planck.obj", 0.8993, 5.9, 14},   {"gargoyle.obj", 0.6667, 13.8, 23}, {"armadillo.obj", 0.4128, 20.0, 27},
+    {"bunny.obj", 0.7064, 31.2, 69},       {"horse.obj", 0.3967, 49.5, 93},    {"igea.ply", 0.9617, 115.7, 252},
+};
+
+const Reference* find_reference(const std::string& path) {
+  const std::string name = file_name(path);
+  for (const Reference& r : kReference)
+    if (name == r.file) return &r;
+  return nullptr;
+}
+
+struct BenchArgs {
+  std::vector<std::string> meshes;
+  std::string meshes_dir;
+  std::string output;
+  std::optional<int> effort;
+  std::optional<int> threads;
+};
+
+bool has_meshes(const fs::path& dir) {
+  std::error_code ec;
+  return fs::is_regular_file(dir / "manifest.json", ec) || fs::is_regular_file(dir / kReference[0].file, ec);
+}
+
+// The dev meshes live in shared/meshes beside the checkout; the program cannot know where
+// its sources were, so look where that folder usually is: $SPHEREKIT_SHARED_DIR, then
+// upwards from the working directory (run from the checkout or a build folder), then
+// upwards from the executable (build/tools/cli/spherekit -> checkout/../shared).
+std::optional<fs::path> find_shared_meshes() {
+  std::error_code ec;
+  if (const char* env = std::getenv("SPHEREKIT_SHARED_DIR"); env && *env) {
+    const fs::path p = fs::path(env) / "meshes";
+    return has_meshes(p) ? std::optional<fs::path>(p) : std::nullopt;
+  }
+  std::vector<fs::path> starts = {fs::current_path(ec)};
+  if (fs::path exe = fs::read_symlink("/proc/self/exe", ec); !ec) starts.push_back(exe.parent_path());
+  for (fs::path dir : starts) {
+    for (int up = 0; up < 6 && !dir.empty(); ++up, dir = dir.parent_path()) {
+      if (has_meshes(dir / "shared" / "meshes")) return dir / "shared" / "meshes";
+      if (dir == dir.parent_path()) break;
+    }
+  }
+  return std::nullopt;
+}
+
+struct ChildRun {
+  int exit_code = -1;
+  double cpu_seconds = 0, wall_seconds = 0, peak_mb = 0;
+};
+
+// Runs this executable with `args`; stdin and stdout go to /dev/null (the child is --quiet
+// anyway), stderr stays ours so its one-line error shows up in the bench output.
+Result<ChildRun> run_child(const std::vector<std::string>& args) {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return Status(ErrorCode::Internal, "cannot locate the spherekit executable: " + ec.message());
+  std::vector<std::string> argv_strings = {exe.string()};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  Stopwatch wall;
+  pid_t pid = 0;
+  const int err = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (err != 0) return Status(ErrorCode::Internal, std::string("cannot start child process: ") + std::strerror(err));
+
+  int status = 0;
+  rusage usage{};
+  pid_t waited = 0;
+  {
+    // While we wait, a signal is forwarded to the child, which cancels and exits; then we
+    // clean up and exit 130 ourselves (see install_signal_handlers).
+    set_child_pid(pid);
+    ComputeScope graceful_cancel;
+    do {
+      waited = wait4(pid, &status, 0, &usage);
+    } while (waited < 0 && errno == EINTR);
+    set_child_pid(0);
+  }
+  if (waited < 0) return Status(ErrorCode::Internal, std::string("wait4 failed: ") + std::strerror(errno));
+
+  ChildRun run;
+  run.wall_seconds = wall.seconds();
+  auto secs = [](const timeval& t) { return static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec); };
+  run.cpu_seconds = secs(usage.ru_utime) + secs(usage.ru_stime);
+  run.peak_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in kB on Linux
+  if (WIFEXITED(status))
+    run.exit_code = WEXITSTATUS(status);
+  else if (WIFSIGNALED(status))
+    run.exit_code = 128 + WTERMSIG(status);
+  return run;
+}
+
+std::string ratio(double ours, double ref) { return ref > 0 ? strprintf("%.2f", ours / ref) : std::string("-"); }
+
+int run_bench(const BenchArgs& a) {
+  // The mesh list: explicit files, else the dev meshes of --meshes-dir or shared/meshes,
+  // else the built-in samples (so the command always has something to measure).
+  std::vector<std::string> meshes = a.meshes;
+  std::string source = "command line";
+  const fs::path work = fs::temp_directory_path() / ("spherekit-bench-" + std::to_string(getpid()));
+  std::error_code ec;
+  fs::create_directories(work, ec);
+  if (ec) return print_error(Status(ErrorCode::IoError, work.string() + ": cannot create folder: " + ec.message()));
+  // Remove the per-mesh outputs (and samples) on every return path.
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() {
+      std::error_code ignored;
+      fs::remove_all(dir, ignored);
+    }
+  } cleanup{work};
+
+  if (meshes.empty()) {
+    std::optional<fs::path> dir;
+    if (!a.meshes_dir.empty()) {
+      if (!fs::is_directory(a.meshes_dir, ec))
+        return print_error(Status(ErrorCode::IoError, a.meshes_dir + ": not a folder"));
+      dir = fs::path(a.meshes_dir);
+    } else {
+      dir = find_shared_meshes();
+    }
+    if (dir) {
+      for (const Reference& r : kReference)
+        if (fs::is_regular_file(*dir / r.file, ec)) meshes.push_back((*dir / r.file).string());
+      source = dir->string();
+    }
+    if (meshes.empty()) {
+      auto collection = samples::make_sample_collection();
+      if (!collection.ok()) return print_error(collection.status());
+      const fs::path sample_dir = work / "samples";
+      fs::create_directories(sample_dir, ec);
+      if (Status s = samples::write_sample_collection(sample_dir.string(), collection.value()); !s.ok())
+        return print_error(s);
+      for (const samples::SampleMesh& m : collection.value()) meshes.push_back((sample_dir / (m.name + ".obj")).string());
+      source = "built-in samples";
+    }
+  }
+  std::printf("spherekit %s bench: %zu meshes from %s\n", kVersion, meshes.size(), source.c_str());
+
+  Table table({"mesh", "V", "F", "eff", "ref eff", "d eff", "flips", "CPU s", "ref CPU", "CPU ratio", "wall s",
+               "peak MB", "ref MB", "MB ratio", "status"});
+  Json rows = Json::array();
+  double cpu_total = 0, ref_cpu_total = 0, cpu_total_with_ref = 0, wall_total = 0;
+  double worst_mb_ratio = 0, worst_eff_delta = 1e300;
+  int worst = 0, failed = 0, flipped_total = 0;
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    const std::string& mesh = meshes[i];
+    const std::string sphere = (work / (std::to_string(i) + ".sphere.obj")).string();
+    const std::string report_path = (work / (std::to_string(i) + ".json")).string();
+    std::vector<std::string> args = {"param", mesh, "-o", sphere, "--report", report_path, "--quiet"};
+    if (a.effort) args.insert(args.end(), {"--effort", std::to_string(*a.effort)});
+    if (a.threads) args.insert(args.end(), {"--threads", std::to_string(*a.threads)});
+    std::fprintf(stderr, "[bench] %zu/%zu %s\n", i + 1, meshes.size(), mesh.c_str());
+
+    auto child = run_child(args);
+    if (!child.ok()) return print_error(child.status());
+    if (cancel_requested()) return print_error(cancelled_status());
+    const ChildRun& c = child.value();
+    const Reference* ref = find_reference(mesh);
+    Json row{{"mesh", mesh}, {"exit_code", c.exit_code}, {"cpu_seconds", c.cpu_seconds},
+             {"wall_seconds", c.wall_seconds}, {"peak_mb", c.peak_mb}};
+    cpu_total += c.cpu_seconds;
+    wall_total += c.wall_seconds;
+
+    Json report;
+    if (c.exit_code == 0) {
+      auto text = formats::read_file(report_path);
+      if (text.ok()) report = Json::parse(text.value(), nullptr, /*allow_exceptions=*/false);
+    }
+    if (c.exit_code != 0 || report.is_discarded() || !report.is_object()) {
+      ++failed;
+      worst = worse_exit_code(worst, c.exit_code != 0 ? c.exit_code : error_code_exit_code(ErrorCode::Internal));
+      row["status"] = "failed";
+      table.add_row({file_name(mesh), "", "", "", ref ? strprintf("%.4f", ref->efficiency) : "-", "", "",
+                     strprintf("%.1f", c.cpu_seconds), ref ? strprintf("%.1f", ref->cpu_seconds) : "-", "",
+                     strprintf("%.1f", c.wall_seconds), strprintf("%.0f", c.peak_mb), ref ? strprintf("%.0f", ref->peak_mb) : "-", "",
+                     strprintf("FAILED (exit %d)", c.exit_code)});
+      rows.push_back(std::move(row));
+      continue;
+    }
+    const double eff = report.value("efficiency", 0.0);
+    const int flips = report.value("flipped_faces", -1);
+    flipped_total += flips;
+    row["status"] = "ok";
+    row["V"] = report.value("V", 0);
+    row["F"] = report.value("F", 0);
+    row["efficiency"] = eff;
+    row["flipped_faces"] = flips;
+    row["winding"] = report.value("winding", 0.0);
+    row["times"] = report.value("times", Json::object());
+    if (ref) {
+      row["reference"] = Json{{"efficiency", ref->efficiency}, {"cpu_seconds", ref->cpu_seconds}, {"peak_mb", ref->peak_mb}};
+      row["efficiency_delta"] = eff - ref->efficiency;
+      row["cpu_ratio"] = c.cpu_seconds / ref->cpu_seconds;
+      row["peak_mb_ratio"] = c.peak_mb / ref->peak_mb;
+      ref_cpu_total += ref->cpu_seconds;
+      cpu_total_with_ref += c.cpu_seconds;
+      worst_mb_ratio = std::max(worst_mb_ratio, c.peak_mb / ref->peak_mb);
+      worst_eff_delta = std::min(worst_eff_delta, eff - ref->efficiency);
+    }
+    table.add_row({file_name(mesh), std::to_string(report.value("V", 0)), std::to_string(report.value("F", 0)),
+                   strprintf("%.4f", eff), ref ? strprintf("%.4f", ref->efficiency) : "-",
+                   ref ? strprintf("%+.4f", eff - ref->efficiency) : "-", std::to_string(flips),
+                   strprintf("%.2f", c.cpu_seconds), ref ? strprintf("%.1f", ref->cpu_seconds) : "-",
+                   ref ? ratio(c.cpu_seconds, ref->cpu_seconds) : "-", strprintf("%.2f", c.wall_seconds),
+                   strprintf("%.0f", c.peak_mb), ref ? strprintf("%.0f", ref->peak_mb) : "-",
+                   ref ? ratio(c.peak_mb, ref->peak_mb) : "-", "ok"});
+    rows.push_back(std::move(row));
+  }
+
+  std::printf("\n");
+  table.print();
+  const bool any_ref = ref_cpu_total > 0;
+  std::printf("\ntotal CPU %.1f s, wall %.1f s", cpu_total, wall_total);
+  if (any_ref)
+    std::printf("; on meshes with reference figures: CPU %.1f s vs %.1f s (ratio %.2f), worst efficiency delta "
+                "%+.4f, worst memory ratio %.2f",
+                cpu_total_with_ref, ref_cpu_total, cpu_total_with_ref / ref_cpu_total, worst_eff_delta, worst_mb_ratio);
+  std::printf("\n%d failed, %d flipped faces in total\n", failed, flipped_total);
+
+  if (!a.output.empty()) {
+    Json j;
+    j["version"] = kVersion;
+    j["source"] = source;
+    j["options"] = Json{{"effort", a.effort ? Json(*a.effort) : Json("default")},
+                        {"threads", a.threads ? Json(*a.threads) : Json("default")}};
+    j["hardware_threads"] = std::thread::hardware_concurrency();
+    j["rows"] = std::move(rows);
+    Json totals{{"meshes", meshes.size()}, {"failed", failed}, {"flipped_faces", flipped_total},
+                {"cpu_seconds", cpu_total}, {"wall_seconds", wall_total}};
+    if (any_ref) {
+      totals["cpu_seconds_with_reference"] = cpu_total_with_ref;
+      totals["reference_cpu_seconds"] = ref_cpu_total;
+      totals["cpu_ratio"] = cpu_total_with_ref / ref_cpu_total;
+      totals["worst_efficiency_delta"] = worst_eff_delta;
+      totals["worst_peak_mb_ratio"] = worst_mb_ratio;
+    }
+    j["totals"] = std::move(totals);
+    if (Status s = write_json_atomic(a.output, j); !s.ok()) return print_error(s);
+    std::printf("wrote %s\n", a.output.c_str());
+  }
+  return worst;
+}
+
+}  // namespace
+
+void register_bench(CLI::App& app) {
+  auto args = std::make_shared<BenchArgs>();
+  CLI::App* cmd = add_command(
+      app, "bench", "Time, memory and efficiency of param per mesh vs. the reference",
+      "Benchmark `param`: run it on each mesh in a child process (so CPU time and peak memory are\n"
+      "per mesh) and print a table of vertices, faces, efficiency, flipped faces, CPU and wall\n"
+      "seconds and peak MB, with the reference implementation's figures (EVALUATION.md §4) and\n"
+      "the ratios ours/reference. Default meshes: the dev meshes (knight ... igea.ply) found in\n"
+      "--meshes-dir, else in $SPHEREKIT_SHARED_DIR/meshes or a shared/meshes folder above the\n"
+      "working directory or the executable; else the built-in samples.",
+      "  spherekit bench -o bench.json\n"
+      "  spherekit bench --meshes-dir ../shared/meshes --effort 2 --threads 2 -o bench.json\n"
+      "  spherekit bench spot.obj gargoyle.obj");
+  cmd->add_option("MESH", args->meshes, "meshes to run (default: the dev meshes)");
+  cmd->add_option("--meshes-dir", args->meshes_dir, "folder holding the dev meshes (knight.obj ... igea.ply)");
+  cmd->add_option("--effort", args->effort, "passed to param (default: param's)")->check(CLI::Range(0, 5));
+  cmd->add_option("--threads", args->threads, "passed to param (default: param's)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("-o,--output", args->output, "write all rows and totals as JSON here");
+  cmd->callback([args] { set_exit_code(run_bench(*args)); });
+}
+
+}  // namespace spherekit::cli

@@ -1,0 +1,139 @@
+// `spherekit consistent`: the consistent parameterization of a collection (paper §3) into a
+// collection folder; `spherekit add`: a new mesh mapped to an existing collection's feature
+// locations (paper §5). The jobs are spherekit::pipeline's (collection.h): this file parses
+// flags, calls them and prints.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "spherekit/pipeline/collection.h"
+
+namespace spherekit::cli {
+namespace {
+
+struct ConsistentArgs {
+  pipeline::MakeCollectionJob job;
+  std::string report;
+  bool quiet = false;
+  SphereParamOptions sphere;
+  ConstrainedFlags flags;
+};
+
+int run_consistent(const ConsistentArgs& a) {
+  Stopwatch wall;
+  if (Status s = require_output_folders({a.report}); !s.ok()) return print_error(s);
+  pipeline::MakeCollectionJob job = a.job;
+  job.options.constrained = a.flags.resolve(a.sphere);
+  job.options.threads = a.sphere.threads;
+  ProgressRenderer progress(a.quiet);
+  auto r = [&] {
+    ComputeScope graceful_cancel;
+    return pipeline::make_collection(job, progress.callback(), [] { return !cancel_requested(); });
+  }();
+  progress.finish();
+  if (cancel_requested()) return print_error(cancelled_status());
+  if (!r.ok()) return print_error(r.status());
+  print_collection_warning(r.value());
+  const double wall_seconds = wall.seconds();
+  if (!a.report.empty()) {
+    Json rep = formats::collection_manifest_json(r->manifest);
+    rep["output"] = job.output;
+    rep["times"]["wall"] = wall_seconds;
+    rep["cpu_seconds"] = cpu_seconds();
+    rep["peak_rss_mb"] = peak_rss_mb();
+    if (Status s = write_json_atomic(a.report, rep); !s.ok()) return print_error(s);
+  }
+  if (!a.quiet) print_consistent_summary(r.value(), job.output, wall_seconds);
+  return 0;
+}
+
+struct AddArgs {
+  pipeline::AddToCollectionJob job;
+  bool quiet = false;
+  SphereParamOptions sphere;
+  ConstrainedFlags flags;
+};
+
+int run_add(const AddArgs& a) {
+  pipeline::AddToCollectionJob job = a.job;
+  job.options = a.flags.resolve(a.sphere);
+  job.seed_given = a.sphere.seed != SphereParamOptions{}.seed;
+  ProgressRenderer progress(a.quiet, job.name.empty() ? file_stem(job.mesh) : job.name);
+  auto r = [&] {
+    ComputeScope graceful_cancel;
+    return pipeline::add_to_collection(job, progress.callback());
+  }();
+  progress.finish();
+  if (cancel_requested()) return print_error(cancelled_status());
+  if (!r.ok()) return print_error(r.status());
+  if (!a.quiet) {
+    const ConstrainedParamResult& m = r->map;
+    std::printf("%s -> %s (%zu features on the collection's locations)\n", job.mesh.c_str(), r->map_path.c_str(), r->features);
+    std::printf("  efficiency %.4f, flipped faces %d, max feature error %.2g rad, %d paths, %d Steiner vertices\n",
+                m.efficiency, m.flipped_faces, m.max_feature_angle, m.network.paths, m.network.steiner_vertices);
+    std::printf("  time %.2f s (wall %.2f s), peak memory %.0f MB\n", m.times.total, r->wall_seconds, peak_rss_mb());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_consistent(CLI::App& app) {
+  auto args = std::make_shared<ConsistentArgs>();
+  CLI::App* cmd = add_command(
+      app, "consistent", "Map a collection of meshes consistently onto one sphere (features coincide)",
+      "Consistent spherical parameterization (Asirvatham, Praun, Hoppe 2005): every mesh is mapped\n"
+      "bijectively onto the unit sphere so that corresponding features (same names in the meshes'\n"
+      "feature files, `name vertex` lines) land on the same sphere points. Then two surface points\n"
+      "correspond when their sphere points are equal ('spherekit correspond').\n"
+      "Steps: 1 unconstrained map of the reference (its features give F'); 2 constrained maps of\n"
+      "the others to F'; 3 remesh all as octahedral geometry images, features snapped; 4 one mesh\n"
+      "in R^3n; 5 its unconstrained map (n-D quadric, summed stretch) gives the final locations F;\n"
+      "6 constrained maps of all meshes to F. --no-refine-locations stops after step 2.\n"
+      "Writes the folder -o DIR: collection.json (manifest), features.txt (`name x y z`: F) and\n"
+      "<stem>.sphere.obj per mesh; DIR is replaced only when everything succeeded. Feature files\n"
+      "default to NAME.lm.txt beside each mesh. Without meshes, the built-in sample collection.",
+      "  spherekit consistent -o cats cat0.obj cat2.obj cat5.obj cat9.obj\n"
+      "  spherekit consistent -o pair bunny.obj gargoyle.obj --features bunny.lm.txt gargoyle.lm.txt\n"
+      "  spherekit consistent -o samples-collection          # the built-in samples");
+  cmd->add_option("MESH", args->job.meshes, "input meshes (genus 0, holes allowed)");
+  cmd->add_option("-o,--output", args->job.output, "collection folder to write")->required();
+  cmd->add_option("--features", args->job.features, "feature files, one per mesh in order (default: MESH stem + .lm.txt)");
+  cmd->add_option("--reference", args->job.reference, "mesh giving the initial locations (file stem or index; default the first)");
+  cmd->add_option("--remesh-size", args->job.options.remesh_size, "step 3 grid side (2^k+1)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({9, 17, 33, 65, 129, 257, 513}));
+  cmd->add_flag("!--no-refine-locations", args->job.options.refine_locations,
+                "stop after step 2 (locations from the reference alone)");
+  cmd->add_flag("!--no-refine", args->job.options.refine_locations)->group("");  // the earlier spelling
+  cmd->add_option("--report", args->report, "also write a JSON report here");
+  cmd->add_flag("-q,--quiet", args->quiet, "print neither progress nor the summary (errors still)");
+  add_sphere_param_options(*cmd, args->sphere);
+  add_constrained_flags(*cmd, args->flags);
+  cmd->callback([args] { set_exit_code(run_consistent(*args)); });
+
+  auto add_args = std::make_shared<AddArgs>();
+  CLI::App* add = add_command(
+      app, "add", "Map a new mesh into an existing collection (its features on the collection's)",
+      "Constrained spherical parameterization of MESH with its features exactly on the collection's\n"
+      "feature locations F (the paper's way to grow a database without recomputing it, §5). The\n"
+      "feature file (default NAME.lm.txt beside the mesh) must name every feature of the\n"
+      "collection. Writes DIR/<stem>.sphere.obj and updates collection.json.",
+      "  spherekit add cats cat10.obj\n"
+      "  spherekit add cats scan.ply --features scan.lm.txt --name cat_scan");
+  add->add_option("DIR", add_args->job.dir, "collection folder")->required();
+  add->add_option("MESH", add_args->job.mesh, "mesh to add")->required();
+  add->add_option("--features", add_args->job.features, "its feature file (default: MESH stem + .lm.txt)");
+  add->add_option("--name", add_args->job.name, "member name (default: the mesh's file stem)");
+  add->add_flag("--replace", add_args->job.replace, "map again if the collection has a member of that name");
+  add->add_flag("-q,--quiet", add_args->quiet, "print neither progress nor the summary (errors still)");
+  add_sphere_param_options(*add, add_args->sphere);
+  add_constrained_flags(*add, add_args->flags);
+  add->callback([add_args] { set_exit_code(run_add(*add_args)); });
+}
+
+}  // namespace spherekit::cli

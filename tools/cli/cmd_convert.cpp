@@ -1,0 +1,157 @@
+// `spherekit convert`: a mesh and its sphere map -> an octahedral geometry image (float EXR),
+// optionally the remesh it defines (OBJ) and Draco glTF levels of detail, with the remesh PSNR
+// against the original; or every member of a collection (--collection). The pipeline is
+// spherekit::pipeline's (convert.h): this file parses flags, calls it and prints.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "spherekit/pipeline/convert.h"
+
+namespace spherekit::cli {
+namespace {
+
+struct ConvertFlags {
+  std::string mesh, sphere, collection, output, remesh, report;
+  std::string positions = "fit", displacement = "scalar";
+  pipeline::ConvertOptions options;
+  bool quiet = false;
+};
+
+// The flags that are wrong whatever the input, before anything is read or written.
+Status resolve_flags(ConvertFlags& a) {
+  SPHEREKIT_RETURN_IF_ERROR(pipeline::check_convert_options(a.options));
+  if (a.positions != "fit" && a.positions != "sampled")
+    return Status(ErrorCode::InvalidArgument, "--positions must be fit or sampled, not '" + a.positions + "'");
+  if (a.displacement != "scalar" && a.displacement != "vector")
+    return Status(ErrorCode::InvalidArgument, "--displacement must be scalar or vector, not '" + a.displacement + "'");
+  a.options.positions = a.positions == "fit" ? pipeline::TexelPositions::Fit : pipeline::TexelPositions::Sampled;
+  a.options.displacement = a.displacement == "vector" ? convert::DisplacementKind::Vector : convert::DisplacementKind::Scalar;
+  if (a.collection.empty() && (a.mesh.empty() || a.sphere.empty()))
+    return Status(ErrorCode::InvalidArgument, "give MESH and SPHERE, or --collection DIR");
+  if (!a.collection.empty() && (!a.mesh.empty() || !a.sphere.empty()))
+    return Status(ErrorCode::InvalidArgument, "--collection converts every member: give no MESH or SPHERE with it");
+  if (!a.collection.empty() && !a.remesh.empty())
+    return Status(ErrorCode::InvalidArgument, "--remesh is for one mesh; with --collection use --report");
+  return Status();
+}
+
+int run_convert(ConvertFlags& a) {
+  if (Status s = resolve_flags(a); !s.ok()) return print_error(s);
+  ProgressRenderer progress(a.quiet, a.collection.empty() ? file_stem(a.mesh) : std::string());
+  if (!a.collection.empty()) {
+    if (Status s = require_output_folders({a.report}); !s.ok()) return print_error(s);
+    auto r = [&] {
+      ComputeScope graceful_cancel;
+      return pipeline::convert_collection({a.collection, a.output, a.options}, progress.callback(),
+                                          [] { return !cancel_requested(); });
+    }();
+    progress.finish();
+    if (!r.ok()) return print_error(r.status());
+    if (!a.report.empty())
+      if (Status s = write_json_atomic(a.report, r->report); !s.ok()) return print_error(s);
+    if (!a.quiet) print_collection_summary(r.value());
+    return 0;
+  }
+  // Every output folder before any work: a bad --report path must not fail the command
+  // after the image was written.
+  if (Status s = require_output_folders({a.output, a.remesh, a.report}); !s.ok()) return print_error(s);
+  auto r = [&] {
+    ComputeScope graceful_cancel;
+    return pipeline::convert_mesh({a.mesh, a.sphere, a.output, a.remesh, a.options}, progress.callback());
+  }();
+  progress.finish();
+  if (cancel_requested()) return print_error(cancelled_status());
+  if (!r.ok()) return print_error(r.status());
+  if (!a.report.empty())
+    if (Status s = write_json_atomic(a.report, pipeline::to_json(r.value())); !s.ok()) return print_error(s);
+  if (!a.quiet) print_mesh_summary(r.value());
+  return 0;
+}
+
+}  // namespace
+
+void register_convert(CLI::App& app) {
+  auto args = std::make_shared<ConvertFlags>();
+  CLI::App* cmd = add_command(
+      app, "convert", "Resample a mesh through its sphere map into an octahedral geometry image (EXR) and glTF LODs",
+      "Resample a mesh through its sphere map (as written by `spherekit param`) into an N x N\n"
+      "octahedral geometry image (N = 2^k+1): each texel's sphere point is located in the sphere\n"
+      "map and the surface position and normal are interpolated there. Writes a float EXR\n"
+      "(R,G,B = position, N.X,N.Y,N.Z = normal, face_id; ZIP; provenance in the header), and\n"
+      "with --remesh the triangle mesh the image defines (holes of the mesh left open), and two\n"
+      "PNG previews of the image,\n"
+      "OUT_normals.png (normals as colours) and OUT_positions.png (positions in the bounding\n"
+      "box as colours; texels in holes of the mesh at half brightness). Prints the remesh PSNR against the\n"
+      "original (peak = bounding-box diagonal, symmetric RMS surface distance; for a mesh with\n"
+      "holes without the remesh faces that have two or three texels in a hole); --report writes\n"
+      "it with the timings as JSON. With --lods L it also writes L levels of detail (image sizes\n"
+      "N, (N-1)/2+1, ..., each resampled and fitted at its own size; faces spanning holes of the\n"
+      "mesh left out) as Draco-compressed glTF (POSITION, NORMAL, TEXCOORD_0 = texel centres\n"
+      "of the image): OUT_lod0.glb ... one per level, and OUT_lods.glb with all of them (MSFT_lod,\n"
+      "level 0 shown by viewers without it), OUT being -o without its extension. Position bits:\n"
+      "the fewest >= --min-position-bits whose quantization error is at most a tenth of the\n"
+      "measured remesh error (recorded in the glTF extras and the report, with each level's\n"
+      "size and the PSNR of its decoded geometry). The mesh must be one `param` accepts and the\n"
+      "map a bijection (no face flipped by the exact predicate).\n"
+      "With --cage N it also fits a Catmull-Clark base cage defined on the sphere domain (the\n"
+      "cube, N x N quads per face, 6N^2 quads, the same for every mesh: in a consistent\n"
+      "collection cage vertex k is the same place on every member) whose limit surface\n"
+      "(OpenSubdiv) best fits the mesh, writes it as OUT_cage.obj with texture coordinates, and\n"
+      "samples the displacement from the limit surface to the mesh on a T x T grid per quad\n"
+      "(--cage-tile T) into one float EXR texture over the cage's UVs, OUT_disp.exr, that DCC\n"
+      "tools apply as is (Blender: blender -b -P scripts/blender_setup_cage.py -- OUT_cage.obj\n"
+      "OUT_disp.exr OUT.blend; T = 2^L+1 for L subdivision levels; see README). It reports the PSNR of the\n"
+      "bare limit surface and of the displaced one.\n"
+      "With --collection DIR (instead of MESH SPHERE) every member of a consistent collection is\n"
+      "converted with the same options into the folder -o: NAME.exr, NAME_normals.png,\n"
+      "NAME_positions.png, NAME_lod*.glb, NAME_cage.obj,\n"
+      "NAME_disp.exr per member, collection_morph.glb (one glTF, the members as morph targets),\n"
+      "and convert_report.json (per member sizes and PSNRs, and per feature the texel that holds\n"
+      "it in every image). All members share one layout: the same texel, cage vertex, glTF\n"
+      "vertex is the same place on every member. The folder appears only when complete.\n"
+      "Exit codes: 2 bad flags (e.g.\n"
+      "--size not 2^k+1), 3 bad input (including a folded map), 4 I/O error.",
+      "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr\n"
+      "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr --size 129 --remesh bunny.gim.obj\n"
+      "  spherekit convert igea.ply igea.sphere.obj -o igea.exr --report igea.convert.json\n"
+      "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --size 257 --lods 4\n"
+      "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --cage 8 --cage-tile 33\n"
+      "  spherekit convert --collection heads/ -o heads_assets/ --size 129 --lods 3 --cage 8");
+  cmd->add_option("MESH", args->mesh, "input mesh (.obj .ply .off .stl .gltf .glb)");
+  cmd->add_option("SPHERE", args->sphere, "its sphere map (.obj, from `spherekit param`)");
+  cmd->add_option("--collection", args->collection,
+                  "instead of MESH SPHERE: convert every member of this collection folder (from `spherekit "
+                  "consistent`) into the folder -o");
+  cmd->add_option("-o,--output", args->output, "geometry image to write (.exr); with --collection: a folder")
+      ->required();
+  cmd->add_option("--size", args->options.size, "image size N = 2^k+1 (default 257)");
+  cmd->add_option("--gi", args->options.size)->group("");  // the earlier spelling
+  cmd->add_option("--remesh", args->remesh, "also write the remesh defined by the image (.obj .ply)");
+  cmd->add_option("--report", args->report, "also write a JSON report here");
+  cmd->add_option("--positions", args->positions,
+                  "texel positions: fit (least-squares fit of the surface, the lower remesh error; default) or "
+                  "sampled (each texel the surface point it samples)");
+  cmd->add_option("--psnr-samples", args->options.psnr_samples,
+                  "points sampled per direction for the PSNR (0: skip it; default 400000)");
+  cmd->add_option("--lods", args->options.lods, "also write this many glTF levels of detail (default 0: none)");
+  cmd->add_option("--min-position-bits", args->options.budget.min_position_bits,
+                  "glTF: fewest Draco position bits (default 14; more if the error budget needs them)");
+  cmd->add_option("--normal-bits", args->options.budget.normal_bits, "glTF: Draco normal bits (default 10)");
+  cmd->add_option("--min-texcoord-bits", args->options.budget.min_texcoord_bits,
+                  "glTF: fewest Draco texture-coordinate bits (default 12)");
+  cmd->add_option("--cage", args->options.cage,
+                  "also fit a Catmull-Clark cage with N x N quads per cube face (OUT_cage.obj) and sample "
+                  "its displacement map (OUT_disp.exr); default 0: none");
+  cmd->add_option("--cage-tile", args->options.cage_tile, "displacement samples per cage-quad edge (default 17)");
+  cmd->add_option("--displacement", args->displacement,
+                  "scalar (along the limit normal, 1 float per sample; default) or vector (3 floats)");
+  cmd->add_flag("-q,--quiet", args->quiet, "print no summary (errors still)");
+  cmd->callback([args] { set_exit_code(run_convert(*args)); });
+}
+
+}  // namespace spherekit::cli

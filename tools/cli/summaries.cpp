@@ -1,0 +1,160 @@
+// The summaries of the jobs' results as the commands print them; `run` prints the same ones
+// for its stages. Results go to stdout, per-member progress lines and warnings to stderr.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "spherekit/pipeline/apps.h"
+#include "spherekit/pipeline/collection.h"
+#include "spherekit/pipeline/convert.h"
+
+namespace spherekit::cli {
+namespace {
+
+std::string db_text(const Json& x) { return x.is_number() ? strprintf("%.1f", x.get<double>()) : std::string("inf"); }
+
+}  // namespace
+
+void print_mesh_summary(const pipeline::ConvertMeshResult& r) {
+  const pipeline::ConvertMeshJob& a = r.job;
+  const pipeline::GeometryAssets& g = r.assets;
+  std::printf("%s + %s -> %s (%d x %d octahedral)\n", a.mesh.c_str(), a.sphere.c_str(), a.output.c_str(), a.options.size,
+              a.options.size);
+  std::printf("  %lld vertices, %lld faces; remesh %lld vertices, %lld faces; %d texel%s in holes\n", r.vertices, r.faces,
+              static_cast<long long>(g.remesh.V.rows()), static_cast<long long>(g.remesh.F.rows()),
+              g.image.texels_in_holes, g.image.texels_in_holes == 1 ? "" : "s");
+  std::printf("  previews %s, %s\n", g.previews.at(0).c_str(), g.previews.at(1).c_str());
+  if (g.measured) {
+    std::printf("  PSNR %.2f dB (rms %.3g, max %.3g, bbox diagonal %.4g)\n", g.error.psnr, g.error.rms,
+                g.error.max_distance, g.error.peak);
+    if (g.error_all_faces)
+      std::printf("  (remesh faces spanning the holes left out; with them: PSNR %.2f dB)\n", g.error_all_faces->psnr);
+  }
+  if (a.options.lods > 0) {
+    const convert::DracoQuantization& q = g.lods.quantization.quantization;
+    std::printf("  glTF (Draco, %d/%d/%d bits position/normal/texcoord%s):\n", q.position_bits, q.normal_bits,
+                q.texcoord_bits, g.lods.quantization.reference_rms_error > 0 ? ", from the error budget" : "");
+    for (std::size_t k = 0; k < g.lods.levels.size(); ++k) {
+      const convert::GltfLodLevel& level = g.lods.levels[k];
+      std::printf("    %s  %3d x %-3d %8lld points %8lld faces %10llu bytes", g.lod_paths.levels[k].c_str(),
+                  level.image_size, level.image_size, static_cast<long long>(level.primitive.decoded.mesh.V.rows()),
+                  static_cast<long long>(level.primitive.decoded.mesh.F.rows()),
+                  static_cast<unsigned long long>(file_bytes(g.lod_paths.levels[k])));
+      if (k < g.lod_errors.size()) std::printf("  PSNR %.2f dB", g.lod_errors[k].psnr);
+      std::printf("\n");
+    }
+    std::printf("    %s  all levels (MSFT_lod) %llu bytes\n", g.lod_paths.combined.c_str(),
+                static_cast<unsigned long long>(file_bytes(g.lod_paths.combined)));
+  }
+  if (g.cage) {
+    const pipeline::CageAssets& c = *g.cage;
+    std::printf("  cage %s: %d quads, %d control points (fit rms %.3g); %s displacement %d x %d per quad -> %s",
+                c.cage_path.c_str(), c.quads, c.control_points, c.fit_rms, pipeline::displacement_kind_name(c.kind), c.tile,
+                c.tile, c.displacement_path.c_str());
+    if (c.measured)
+      std::printf("\n    PSNR limit surface %.2f dB, displaced %.2f dB (%lld floats stored)", c.limit_error.psnr,
+                  c.displaced_error.psnr, c.stored_floats);
+    std::printf("  %.2f s\n", c.seconds);
+  }
+  std::printf("  time: read %.2f s, sample %.3f s, remesh %.3f s, write %.2f s, PSNR %.2f s, %stotal %.2f s\n",
+              r.read_seconds, g.times.sample, g.times.remesh, g.times.write, g.times.psnr,
+              a.options.lods > 0 ? strprintf("glTF %.2f s + PSNR %.2f s, ", g.times.gltf, g.times.gltf_psnr).c_str() : "",
+              r.wall_seconds);
+}
+
+void print_collection_summary(const pipeline::ConvertCollectionResult& r) {
+  const pipeline::ConvertOptions& o = r.job.options;
+  for (const pipeline::ConvertedMember& m : r.members) {
+    std::fprintf(stderr, "  %-24s %d x %d", m.name.c_str(), o.size, o.size);
+    if (m.assets.measured) std::fprintf(stderr, "  PSNR %.2f dB", m.assets.error.psnr);
+    if (m.assets.cage && m.assets.cage->measured && std::isfinite(m.assets.cage->displaced_error.psnr))
+      std::fprintf(stderr, "  cage+displacement %.2f dB", m.assets.cage->displaced_error.psnr);
+    std::fprintf(stderr, "  %.1f s\n", m.seconds);
+  }
+  std::printf("%s -> %s: %zu members, %d x %d octahedral images%s%s, %.1f s\n", r.job.collection.c_str(),
+              r.job.output.c_str(), r.members.size(), o.size, o.size,
+              o.lods > 0 ? strprintf(", %d glTF LODs", o.lods).c_str() : "",
+              o.cage > 0 ? strprintf(", cage %d + %s displacement", o.cage, pipeline::displacement_kind_name(o.displacement)).c_str() : "",
+              r.wall_seconds);
+}
+
+void print_collection_warning(const pipeline::MakeCollectionResult& r) {
+  if (!r.refinement_warning.empty())
+    std::fprintf(stderr, "spherekit: warning: step 6 failed (%s); the collection keeps the step-2 maps (locations from the reference)\n",
+                 r.refinement_warning.c_str());
+}
+
+void print_consistent_summary(const pipeline::MakeCollectionResult& c, const std::string& output, double wall_seconds) {
+  const ConsistentParamResult& r = c.maps;
+  const bool refined = c.manifest.options.value("refine_locations", true);
+  const std::string& reference = c.members[static_cast<size_t>(c.reference)].name;
+  std::printf("collection %s: %zu meshes, %zu features (%s)\n", output.c_str(), c.members.size(), c.feature_names.size(),
+              refined && r.refinement_failure.empty() ? "locations from all meshes" : "locations from the reference only");
+  Table steps({"step", "work", "time (s)"});
+  steps.add_row({"1", "unconstrained map of " + reference, strprintf("%.2f", r.times.reference)});
+  steps.add_row({"2", strprintf("constrained maps of %zu meshes to F'", c.members.size() - 1), strprintf("%.2f", r.times.initial)});
+  if (refined && c.members.size() > 1) {
+    const int grid = c.manifest.options.value("remesh_size", 0);
+    steps.add_row({"3", strprintf("remesh %d x %d, features snapped", grid, grid), strprintf("%.2f", r.times.remesh)});
+    steps.add_row({"4", strprintf("concatenate: %d vertices in R^%zu", r.remesh_vertices, 3 * c.members.size()),
+                   strprintf("%.2f", r.times.concatenate)});
+    steps.add_row({"5", strprintf("joint unconstrained map (efficiency %.4f)", r.joint_efficiency), strprintf("%.2f", r.times.joint)});
+    steps.add_row({"6", strprintf("constrained maps of %zu meshes to F", c.members.size()), strprintf("%.2f", r.times.final_maps)});
+  }
+  steps.add_row({"", "total", strprintf("%.2f", r.times.total)});
+  steps.print();
+  std::printf("\n");
+  Table t({"mesh", "V", "efficiency", "flips", "feature err (rad)", "paths", "path len", "max len/geo", "Steiner", "time (s)"});
+  for (size_t i = 0; i < c.members.size(); ++i) {
+    const auto& m = r.maps[i];
+    t.add_row({c.members[i].name, std::to_string(c.members[i].mesh.V.rows()), strprintf("%.4f", m.efficiency),
+               std::to_string(m.flipped_faces), strprintf("%.1e", m.max_feature_angle), std::to_string(m.network.paths),
+               strprintf("%.4g", m.network.total_length), strprintf("%.2f", m.network.max_ratio),
+               std::to_string(m.network.steiner_vertices), strprintf("%.2f", m.times.total)});
+  }
+  t.print();
+  std::printf("wall %.2f s, CPU %.2f s, peak memory %.0f MB\n", wall_seconds, cpu_seconds(), peak_rss_mb());
+}
+
+void print_transfer_summary(const pipeline::TransferResult& r, const pipeline::TransferJob& job) {
+  std::printf("transfer %s: %s -> %s: %s (%lld vertices", pipeline::transfer_what_name(job.what), r.from.c_str(),
+              r.to.c_str(), job.output.c_str(), r.vertices);
+  if (r.vertices_in_holes) std::printf(", %d in holes of %s", r.vertices_in_holes, r.from.c_str());
+  std::printf(")\n");
+}
+
+void print_morph_summary(const pipeline::MorphResult& r, const pipeline::MorphJob& job) {
+  std::printf("morph %s -> %s: %d frames of %lld vertices (%s) in %s\n", r.a.c_str(), r.b.c_str(), job.frames, r.vertices,
+              r.aligned ? strprintf("aligned: scale %.3f, rotation %.1f deg", r.scale, r.rotation_deg).c_str() : "not aligned",
+              job.output.c_str());
+}
+
+void print_pca_summary(const pipeline::PcaResult& result, const pipeline::PcaJob& job) {
+  const Json& rep = result.report;
+  std::printf("PCA of %zu members (%lld vertices each): %d components\n", rep["members"].size(),
+              rep["vertices"].get<long long>(), rep["components"].get<int>());
+  Table t({"components", "mean RMS", "max RMS", "mean PSNR dB", "variance"});
+  double cumulative = 0;
+  for (const Json& e : rep["errors"]) {
+    const int k = e["components"].get<int>();
+    if (k > 0) cumulative += rep["variance_fraction"][static_cast<std::size_t>(k - 1)].get<double>();
+    t.add_row({std::to_string(k), strprintf("%.3g", e["mean_rms"].get<double>()), strprintf("%.3g", e["max_rms"].get<double>()),
+               db_text(e["mean_psnr_db"]), strprintf("%.1f%%", 100 * cumulative)});
+  }
+  t.print();
+  if (!rep["compression"].empty()) {
+    Table c({"method", "k", "bits", "bytes/shape", "deflated", "mean PSNR dB"});
+    for (const Json& p : rep["compression"]) {
+      const int bits = p["bits"].get<int>();
+      c.add_row({p["method"].get<std::string>(), p["method"] == "pca" ? std::to_string(p["components"].get<int>()) : "-",
+                 bits ? std::to_string(bits) : "f32", strprintf("%.0f", p["bytes_per_shape"].get<double>()),
+                 strprintf("%.0f", p["deflated_bytes_per_shape"].get<double>()), db_text(p["mean_psnr_db"])});
+    }
+    c.print();
+  }
+  std::printf("wrote %s\n", job.output.c_str());
+}
+
+}  // namespace spherekit::cli

@@ -14,6 +14,7 @@
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/file_status.h"
+#include "spherekit/format_text.h"
 
 namespace fs = std::filesystem;
 
@@ -22,19 +23,6 @@ namespace {
 
 using Json = OrderedJson;
 
-std::string text_printf(const char* format, ...) __attribute__((format(printf, 1, 2)));
-std::string text_printf(const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  va_list copy;
-  va_copy(copy, args);
-  const int n = std::vsnprintf(nullptr, 0, format, copy);
-  va_end(copy);
-  std::string out(n > 0 ? static_cast<size_t>(n) : 0, '\0');
-  if (n > 0) std::vsnprintf(out.data(), out.size() + 1, format, args);
-  va_end(args);
-  return out;
-}
 
 Status bad(const std::string& file, const std::string& what) {
   return Status(ErrorCode::InvalidInput, file + ": " + what);
@@ -190,7 +178,7 @@ Status check_features_file(const Collection& c) {
       return bad(path, "feature '" + f.name + "' is not where " + manifest + " puts it");
   }
   if (points->size() != c.manifest.features.size())
-    return bad(path, text_printf("has %zu features, %s has %zu", points->size(), manifest.c_str(),
+    return bad(path, format_text("has %zu features, %s has %zu", points->size(), manifest.c_str(),
                                  c.manifest.features.size()));
   return Status();
 }
@@ -224,8 +212,8 @@ Result<CollectionManifest> parse_collection_manifest(const std::string& text, co
     // Where it broke tells a cut-off file (a copy interrupted mid-way) from an edit gone wrong.
     if (e.byte >= text.size())
       return Status(ErrorCode::ParseError,
-                    text_printf("%s: not valid JSON: ends early after %zu bytes (truncated?)", file.c_str(), text.size()));
-    return Status(ErrorCode::ParseError, text_printf("%s: not valid JSON (syntax error at byte %zu)", file.c_str(), e.byte));
+                    format_text("%s: not valid JSON: ends early after %zu bytes (truncated?)", file.c_str(), text.size()));
+    return Status(ErrorCode::ParseError, format_text("%s: not valid JSON (syntax error at byte %zu)", file.c_str(), e.byte));
   } catch (const Json::exception& e) {
     // The parser's other refusals, e.g. "number overflow parsing '1e400'" (out_of_range).
     std::string why = e.what();
@@ -301,7 +289,7 @@ Status check_member_maps(const Collection& c, int skip) {
     auto map = read_mesh(path);
     if (!map.ok()) return with_file(map.status(), path);
     if (e.vertices && map->V.rows() != *e.vertices)
-      return bad(path, text_printf("has %lld vertices, %s records %lld for member '%s'",
+      return bad(path, format_text("has %lld vertices, %s records %lld for member '%s'",
                                    static_cast<long long>(map->V.rows()), manifest.c_str(), *e.vertices, e.name.c_str()));
   }
   return Status();
@@ -369,7 +357,7 @@ Result<std::vector<LoadedMember>> load_collection_members(const Collection& c) {
 std::string sphere_points_text(const std::vector<std::string>& names, const std::vector<Eigen::Vector3d>& points) {
   std::string out;
   for (size_t i = 0; i < names.size(); ++i)
-    out += text_printf("%s %.17g %.17g %.17g\n", names[i].c_str(), points[i].x(), points[i].y(), points[i].z());
+    out += format_text("%s %.17g %.17g %.17g\n", names[i].c_str(), points[i].x(), points[i].y(), points[i].z());
   return out;
 }
 

@@ -17,15 +17,14 @@
 #include "spherekit/pipeline/collection.h"
 #include "spherekit/pipeline/json.h"
 #include "spherekit/version.h"
+#include "spherekit/format_text.h"
 #include "stopwatch.h"
-#include "text.h"
 
 namespace fs = std::filesystem;
 
 namespace spherekit::pipeline {
 namespace {
 
-using detail::format_text;
 
 // A map may enter a collection only if it is a bijection with every feature on its location.
 Status require_exact(const ConstrainedParamResult& r, const std::string& label) {
@@ -168,14 +167,7 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
 }  // namespace
 
 Json map_entry_json(const ConstrainedParamResult& r) {
-  Json j;
-  j["efficiency"] = r.efficiency;
-  j["l2_stretch"] = r.l2_stretch;
-  j["linf_stretch"] = r.linf_stretch;
-  j["flipped_faces"] = r.flipped_faces;
-  j["winding"] = r.winding;
-  j["max_feature_angle"] = r.max_feature_angle;
-  j["holes_filled"] = r.holes_filled;
+  Json j = constrained_measures_json(r);
   j["method"] = r.map.provenance.method;
   j["network"] = feature_network_json(r.network);
   j["times"] = Json{{"network", r.times.network}, {"simplify", r.times.simplify},

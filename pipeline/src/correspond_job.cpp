@@ -9,14 +9,14 @@
 #include "spherekit/pipeline/correspond.h"
 #include "spherekit/pipeline/mesh_input.h"
 #include "spherekit/pipeline/paths.h"
-#include "text.h"
+
+#include "spherekit/format_text.h"
 
 namespace fs = std::filesystem;
 
 namespace spherekit::pipeline {
 namespace {
 
-using detail::format_text;
 using formats::Collection;
 using formats::kCollectionManifest;
 

@@ -65,6 +65,18 @@ Json constrained_options_json(const ConstrainedParamOptions& o) {
   return j;
 }
 
+Json constrained_measures_json(const ConstrainedParamResult& r) {
+  Json j;
+  j["efficiency"] = r.efficiency;
+  j["l2_stretch"] = r.l2_stretch;
+  j["linf_stretch"] = r.linf_stretch;
+  j["flipped_faces"] = r.flipped_faces;
+  j["winding"] = r.winding;
+  j["max_feature_angle"] = r.max_feature_angle;
+  j["holes_filled"] = r.holes_filled;
+  return j;
+}
+
 Json feature_network_json(const FeatureNetworkReport& n) {
   return Json{{"auxiliary_features", n.auxiliary_features},
               {"paths", n.paths},

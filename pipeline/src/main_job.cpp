@@ -17,9 +17,9 @@
 #include "spherekit/pipeline/process_stats.h"
 #include "spherekit/pipeline/site_page.h"
 #include "spherekit/version.h"
+#include "spherekit/format_text.h"
 #include "stopwatch.h"
 #include "main_job_stages.h"
-#include "text.h"
 
 namespace fs = std::filesystem;
 
@@ -40,7 +40,6 @@ void MainJobObserver::pca_done(const PcaResult&, const PcaJob&) {}
 
 namespace {
 
-using detail::format_text;
 
 // glTF levels of detail per mesh from its image (129, 65, 33), for the page's 3-D view.
 constexpr int kGeometryImageLods = 3;

@@ -10,13 +10,12 @@
 #include "spherekit/pipeline/paths.h"
 #include "spherekit/pipeline/process_stats.h"
 #include "spherekit/version.h"
+#include "spherekit/format_text.h"
 #include "stopwatch.h"
-#include "text.h"
 
 namespace spherekit::pipeline {
 namespace {
 
-using detail::format_text;
 
 Json provenance_json(const Provenance& p) {
   return Json{{"library_version", p.library_version},
@@ -120,13 +119,8 @@ Json to_json(const ParamResult& p) {
     j["V"] = m.check.vertices;
     j["F"] = m.check.faces;
     j["method"] = "constrained";
-    j["efficiency"] = r.efficiency;
-    j["l2_stretch"] = r.l2_stretch;
-    j["linf_stretch"] = r.linf_stretch;
-    j["flipped_faces"] = r.flipped_faces;
-    j["winding"] = r.winding;
-    j["max_feature_angle"] = r.max_feature_angle;
-    j["holes_filled"] = r.holes_filled;
+    const Json measures = constrained_measures_json(r);  // named: items() does not extend its lifetime
+    for (const auto& [key, value] : measures.items()) j[key] = value;
     j["network"] = feature_network_json(r.network);
     j["network"]["features"] = p.features;
     j["times"] = Json{{"read", m.read_seconds}, {"check", r.times.check},     {"network", r.times.network},

@@ -16,8 +16,8 @@
 #include "spherekit/formats/mesh_attributes.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/pipeline/apps.h"
+#include "spherekit/format_text.h"
 #include "stopwatch.h"
-#include "text.h"
 
 namespace spherekit::pipeline {
 namespace {
@@ -25,7 +25,6 @@ namespace {
 using formats::LoadedMember;
 using formats::OutputFiles;
 
-using detail::format_text;
 
 std::string csv_number(double x) { return std::isfinite(x) ? format_text("%.9g", x) : std::string("inf"); }
 

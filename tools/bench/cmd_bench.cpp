@@ -145,7 +145,7 @@ Result<ChildRun> run_child(const std::vector<std::string>& args) {
   return run;
 }
 
-std::string ratio(double ours, double ref) { return ref > 0 ? strprintf("%.2f", ours / ref) : std::string("-"); }
+std::string ratio(double ours, double ref) { return ref > 0 ? format_text("%.2f", ours / ref) : std::string("-"); }
 
 int run_bench(const BenchArgs& a) {
   // The mesh list: explicit files, else the dev meshes of --meshes-dir or shared/meshes,
@@ -226,10 +226,10 @@ int run_bench(const BenchArgs& a) {
       ++failed;
       worst = worse_exit_code(worst, c.exit_code != 0 ? c.exit_code : error_code_exit_code(ErrorCode::Internal));
       row["status"] = "failed";
-      table.add_row({file_name(mesh), "", "", "", ref ? strprintf("%.4f", ref->efficiency) : "-", "", "",
-                     strprintf("%.1f", c.cpu_seconds), ref ? strprintf("%.1f", ref->cpu_seconds) : "-", "",
-                     strprintf("%.1f", c.wall_seconds), strprintf("%.0f", c.peak_mb), ref ? strprintf("%.0f", ref->peak_mb) : "-", "",
-                     strprintf("FAILED (exit %d)", c.exit_code)});
+      table.add_row({file_name(mesh), "", "", "", ref ? format_text("%.4f", ref->efficiency) : "-", "", "",
+                     format_text("%.1f", c.cpu_seconds), ref ? format_text("%.1f", ref->cpu_seconds) : "-", "",
+                     format_text("%.1f", c.wall_seconds), format_text("%.0f", c.peak_mb), ref ? format_text("%.0f", ref->peak_mb) : "-", "",
+                     format_text("FAILED (exit %d)", c.exit_code)});
       rows.push_back(std::move(row));
       continue;
     }
@@ -254,11 +254,11 @@ int run_bench(const BenchArgs& a) {
       worst_eff_delta = std::min(worst_eff_delta, eff - ref->efficiency);
     }
     table.add_row({file_name(mesh), std::to_string(report.value("V", 0)), std::to_string(report.value("F", 0)),
-                   strprintf("%.4f", eff), ref ? strprintf("%.4f", ref->efficiency) : "-",
-                   ref ? strprintf("%+.4f", eff - ref->efficiency) : "-", std::to_string(flips),
-                   strprintf("%.2f", c.cpu_seconds), ref ? strprintf("%.1f", ref->cpu_seconds) : "-",
-                   ref ? ratio(c.cpu_seconds, ref->cpu_seconds) : "-", strprintf("%.2f", c.wall_seconds),
-                   strprintf("%.0f", c.peak_mb), ref ? strprintf("%.0f", ref->peak_mb) : "-",
+                   format_text("%.4f", eff), ref ? format_text("%.4f", ref->efficiency) : "-",
+                   ref ? format_text("%+.4f", eff - ref->efficiency) : "-", std::to_string(flips),
+                   format_text("%.2f", c.cpu_seconds), ref ? format_text("%.1f", ref->cpu_seconds) : "-",
+                   ref ? ratio(c.cpu_seconds, ref->cpu_seconds) : "-", format_text("%.2f", c.wall_seconds),
+                   format_text("%.0f", c.peak_mb), ref ? format_text("%.0f", ref->peak_mb) : "-",
                    ref ? ratio(c.peak_mb, ref->peak_mb) : "-", "ok"});
     rows.push_back(std::move(row));
   }

@@ -180,18 +180,6 @@ Status write_json_atomic(const std::string& path, const Json& json) {
   return formats::write_file_atomic(path, json.dump(2) + "\n");
 }
 
-std::string strprintf(const char* format, ...) {
-  va_list args;
-  va_start(args, format);
-  va_list copy;
-  va_copy(copy, args);
-  const int n = std::vsnprintf(nullptr, 0, format, copy);
-  va_end(copy);
-  std::string out(n > 0 ? static_cast<size_t>(n) : 0, '\0');
-  if (n > 0) std::vsnprintf(out.data(), out.size() + 1, format, args);
-  va_end(args);
-  return out;
-}
 
 std::string file_stem(const std::string& path) { return fs::path(path).stem().string(); }
 std::string file_name(const std::string& path) { return fs::path(path).filename().string(); }

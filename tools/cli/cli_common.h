@@ -20,6 +20,7 @@
 #include "spherekit/constrained_param.h"
 #include "spherekit/sphere_param.h"
 #include "spherekit/file_status.h"
+#include "spherekit/format_text.h"
 #include "spherekit/pipeline/json.h"
 #include "spherekit/pipeline/mesh_input.h"
 #include "spherekit/pipeline/paths.h"
@@ -157,8 +158,6 @@ using pipeline::peak_rss_mb;
 /// Writes `json` (indented, trailing newline) to `path` atomically. Errors: IoError.
 Status write_json_atomic(const std::string& path, const Json& json);
 
-/// printf-style formatting into a std::string (g++ 12 has no <format>).
-std::string strprintf(const char* format, ...) __attribute__((format(printf, 1, 2)));
 
 /// File name without folder and last extension ("a/b/spot.obj" -> "spot").
 std::string file_stem(const std::string& path);

@@ -3,8 +3,8 @@
 // against the original; or every member of a collection (--collection). The pipeline is
 // spherekit::pipeline's (convert.h): this file parses flags, calls it and prints.
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -17,20 +17,13 @@ namespace {
 
 struct ConvertFlags {
   std::string mesh, sphere, collection, output, remesh, report;
-  std::string positions = "fit", displacement = "scalar";
   pipeline::ConvertOptions options;
   bool quiet = false;
 };
 
 // The flags that are wrong whatever the input, before anything is read or written.
-Status resolve_flags(ConvertFlags& a) {
+Status check_flags(const ConvertFlags& a) {
   SPHEREKIT_RETURN_IF_ERROR(pipeline::check_convert_options(a.options));
-  if (a.positions != "fit" && a.positions != "sampled")
-    return Status(ErrorCode::InvalidArgument, "--positions must be fit or sampled, not '" + a.positions + "'");
-  if (a.displacement != "scalar" && a.displacement != "vector")
-    return Status(ErrorCode::InvalidArgument, "--displacement must be scalar or vector, not '" + a.displacement + "'");
-  a.options.positions = a.positions == "fit" ? pipeline::TexelPositions::Fit : pipeline::TexelPositions::Sampled;
-  a.options.displacement = a.displacement == "vector" ? convert::DisplacementKind::Vector : convert::DisplacementKind::Scalar;
   if (a.collection.empty() && (a.mesh.empty() || a.sphere.empty()))
     return Status(ErrorCode::InvalidArgument, "give MESH and SPHERE, or --collection DIR");
   if (!a.collection.empty() && (!a.mesh.empty() || !a.sphere.empty()))
@@ -40,8 +33,8 @@ Status resolve_flags(ConvertFlags& a) {
   return Status();
 }
 
-int run_convert(ConvertFlags& a) {
-  if (Status s = resolve_flags(a); !s.ok()) return print_error(s);
+int run_convert(const ConvertFlags& a) {
+  if (Status s = check_flags(a); !s.ok()) return print_error(s);
   ProgressRenderer progress(a.quiet, a.collection.empty() ? file_stem(a.mesh) : std::string());
   if (!a.collection.empty()) {
     if (Status s = require_output_folders({a.report}); !s.ok()) return print_error(s);
@@ -133,9 +126,12 @@ void register_convert(CLI::App& app) {
   cmd->add_option("--gi", args->options.size)->group("");  // the earlier spelling
   cmd->add_option("--remesh", args->remesh, "also write the remesh defined by the image (.obj .ply)");
   cmd->add_option("--report", args->report, "also write a JSON report here");
-  cmd->add_option("--positions", args->positions,
+  cmd->add_option("--positions", args->options.positions,
                   "texel positions: fit (least-squares fit of the surface, the lower remesh error; default) or "
-                  "sampled (each texel the surface point it samples)");
+                  "sampled (each texel the surface point it samples)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, pipeline::TexelPositions>{{"fit", pipeline::TexelPositions::Fit},
+                                                          {"sampled", pipeline::TexelPositions::Sampled}}));
   cmd->add_option("--psnr-samples", args->options.psnr_samples,
                   "points sampled per direction for the PSNR (0: skip it; default 400000)");
   cmd->add_option("--lods", args->options.lods, "also write this many glTF levels of detail (default 0: none)");
@@ -148,8 +144,11 @@ void register_convert(CLI::App& app) {
                   "also fit a Catmull-Clark cage with N x N quads per cube face (OUT_cage.obj) and sample "
                   "its displacement map (OUT_disp.exr); default 0: none");
   cmd->add_option("--cage-tile", args->options.cage_tile, "displacement samples per cage-quad edge (default 17)");
-  cmd->add_option("--displacement", args->displacement,
-                  "scalar (along the limit normal, 1 float per sample; default) or vector (3 floats)");
+  cmd->add_option("--displacement", args->options.displacement,
+                  "scalar (along the limit normal, 1 float per sample; default) or vector (3 floats)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, convert::DisplacementKind>{{"scalar", convert::DisplacementKind::Scalar},
+                                                           {"vector", convert::DisplacementKind::Vector}}));
   cmd->add_flag("-q,--quiet", args->quiet, "print no summary (errors still)");
   cmd->callback([args] { set_exit_code(run_convert(*args)); });
 }

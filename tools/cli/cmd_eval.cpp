@@ -70,7 +70,7 @@ int run_eval(const EvalArgs& a) {
   const auto nv = mesh->V.rows();
   if (sphere->V.rows() != nv)
     return print_error(Status(ErrorCode::InvalidInput,
-                              strprintf("%s: sphere map has %lld vertices, mesh %s has %lld", a.sphere.c_str(),
+                              format_text("%s: sphere map has %lld vertices, mesh %s has %lld", a.sphere.c_str(),
                                         static_cast<long long>(sphere->V.rows()), a.mesh.c_str(),
                                         static_cast<long long>(nv))));
 
@@ -81,7 +81,7 @@ int run_eval(const EvalArgs& a) {
     const double radius = sphere->V.row(i).cwiseAbs().maxCoeff();
     if (radius > kMaxCoordinate || (radius > 0 && radius < kMinExtent))
       return print_error(Status(ErrorCode::InvalidInput,
-                                strprintf("%s: point %lld is %.3g from the origin, outside the %.0e..%.0e eval "
+                                format_text("%s: point %lld is %.3g from the origin, outside the %.0e..%.0e eval "
                                           "can measure; normalise the points",
                                           a.sphere.c_str(), static_cast<long long>(i), sphere->V.row(i).stableNorm(),
                                           kMinExtent, kMaxCoordinate)));

@@ -24,7 +24,7 @@ struct EvalSurfaceArgs {
 
 int run_eval_surface(const EvalSurfaceArgs& a) {
   if (a.samples < 1000 || a.samples > 100000000)
-    return print_error(Status(ErrorCode::InvalidArgument, strprintf("--samples %d is not in 1000..1e8", a.samples)));
+    return print_error(Status(ErrorCode::InvalidArgument, format_text("--samples %d is not in 1000..1e8", a.samples)));
   formats::ReadOptions lenient;
   lenient.polygons = formats::PolygonPolicy::Triangulate;
   auto original = formats::read_mesh(a.original, lenient);

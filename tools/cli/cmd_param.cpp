@@ -28,7 +28,7 @@ void print_summary(const pipeline::ParamResult& p) {
     std::printf("  network: %d paths, total length %.4g, max length/geodesic %.3f, %d swirls fixed, %d flips, %d Steiner vertices%s\n",
                 r.network.paths, r.network.total_length, r.network.max_ratio, r.network.swirls_fixed, r.network.edge_flips,
                 r.network.steiner_vertices,
-                r.network.auxiliary_features ? strprintf(", %d auxiliary features", r.network.auxiliary_features).c_str() : "");
+                r.network.auxiliary_features ? format_text(", %d auxiliary features", r.network.auxiliary_features).c_str() : "");
     std::printf("  efficiency %.4f, L2 stretch %.4f, flipped faces %d, winding %.6f, max feature error %.2g rad\n",
                 r.efficiency, r.l2_stretch, r.flipped_faces, r.winding, r.max_feature_angle);
     std::printf("  time: network %.2f s, simplify %.2f s, refine %.2f s, total %.2f s (wall %.2f s, CPU %.2f s), peak memory %.0f MB\n",

@@ -13,7 +13,7 @@
 namespace spherekit::cli {
 namespace {
 
-std::string db_text(const Json& x) { return x.is_number() ? strprintf("%.1f", x.get<double>()) : std::string("inf"); }
+std::string db_text(const Json& x) { return x.is_number() ? format_text("%.1f", x.get<double>()) : std::string("inf"); }
 
 }  // namespace
 
@@ -60,7 +60,7 @@ void print_mesh_summary(const pipeline::ConvertMeshResult& r) {
   }
   std::printf("  time: read %.2f s, sample %.3f s, remesh %.3f s, write %.2f s, PSNR %.2f s, %stotal %.2f s\n",
               r.read_seconds, g.times.sample, g.times.remesh, g.times.write, g.times.psnr,
-              a.options.lods > 0 ? strprintf("glTF %.2f s + PSNR %.2f s, ", g.times.gltf, g.times.gltf_psnr).c_str() : "",
+              a.options.lods > 0 ? format_text("glTF %.2f s + PSNR %.2f s, ", g.times.gltf, g.times.gltf_psnr).c_str() : "",
               r.wall_seconds);
 }
 
@@ -75,8 +75,8 @@ void print_collection_summary(const pipeline::ConvertCollectionResult& r) {
   }
   std::printf("%s -> %s: %zu members, %d x %d octahedral images%s%s, %.1f s\n", r.job.collection.c_str(),
               r.job.output.c_str(), r.members.size(), o.size, o.size,
-              o.lods > 0 ? strprintf(", %d glTF LODs", o.lods).c_str() : "",
-              o.cage > 0 ? strprintf(", cage %d + %s displacement", o.cage, pipeline::displacement_kind_name(o.displacement)).c_str() : "",
+              o.lods > 0 ? format_text(", %d glTF LODs", o.lods).c_str() : "",
+              o.cage > 0 ? format_text(", cage %d + %s displacement", o.cage, pipeline::displacement_kind_name(o.displacement)).c_str() : "",
               r.wall_seconds);
 }
 
@@ -93,26 +93,26 @@ void print_consistent_summary(const pipeline::MakeCollectionResult& c, const std
   std::printf("collection %s: %zu meshes, %zu features (%s)\n", output.c_str(), c.members.size(), c.feature_names.size(),
               refined && r.refinement_failure.empty() ? "locations from all meshes" : "locations from the reference only");
   Table steps({"step", "work", "time (s)"});
-  steps.add_row({"1", "unconstrained map of " + reference, strprintf("%.2f", r.times.reference)});
-  steps.add_row({"2", strprintf("constrained maps of %zu meshes to F'", c.members.size() - 1), strprintf("%.2f", r.times.initial)});
+  steps.add_row({"1", "unconstrained map of " + reference, format_text("%.2f", r.times.reference)});
+  steps.add_row({"2", format_text("constrained maps of %zu meshes to F'", c.members.size() - 1), format_text("%.2f", r.times.initial)});
   if (refined && c.members.size() > 1) {
     const int grid = c.manifest.options.value("remesh_size", 0);
-    steps.add_row({"3", strprintf("remesh %d x %d, features snapped", grid, grid), strprintf("%.2f", r.times.remesh)});
-    steps.add_row({"4", strprintf("concatenate: %d vertices in R^%zu", r.remesh_vertices, 3 * c.members.size()),
-                   strprintf("%.2f", r.times.concatenate)});
-    steps.add_row({"5", strprintf("joint unconstrained map (efficiency %.4f)", r.joint_efficiency), strprintf("%.2f", r.times.joint)});
-    steps.add_row({"6", strprintf("constrained maps of %zu meshes to F", c.members.size()), strprintf("%.2f", r.times.final_maps)});
+    steps.add_row({"3", format_text("remesh %d x %d, features snapped", grid, grid), format_text("%.2f", r.times.remesh)});
+    steps.add_row({"4", format_text("concatenate: %d vertices in R^%zu", r.remesh_vertices, 3 * c.members.size()),
+                   format_text("%.2f", r.times.concatenate)});
+    steps.add_row({"5", format_text("joint unconstrained map (efficiency %.4f)", r.joint_efficiency), format_text("%.2f", r.times.joint)});
+    steps.add_row({"6", format_text("constrained maps of %zu meshes to F", c.members.size()), format_text("%.2f", r.times.final_maps)});
   }
-  steps.add_row({"", "total", strprintf("%.2f", r.times.total)});
+  steps.add_row({"", "total", format_text("%.2f", r.times.total)});
   steps.print();
   std::printf("\n");
   Table t({"mesh", "V", "efficiency", "flips", "feature err (rad)", "paths", "path len", "max len/geo", "Steiner", "time (s)"});
   for (size_t i = 0; i < c.members.size(); ++i) {
     const auto& m = r.maps[i];
-    t.add_row({c.members[i].name, std::to_string(c.members[i].mesh.V.rows()), strprintf("%.4f", m.efficiency),
-               std::to_string(m.flipped_faces), strprintf("%.1e", m.max_feature_angle), std::to_string(m.network.paths),
-               strprintf("%.4g", m.network.total_length), strprintf("%.2f", m.network.max_ratio),
-               std::to_string(m.network.steiner_vertices), strprintf("%.2f", m.times.total)});
+    t.add_row({c.members[i].name, std::to_string(c.members[i].mesh.V.rows()), format_text("%.4f", m.efficiency),
+               std::to_string(m.flipped_faces), format_text("%.1e", m.max_feature_angle), std::to_string(m.network.paths),
+               format_text("%.4g", m.network.total_length), format_text("%.2f", m.network.max_ratio),
+               std::to_string(m.network.steiner_vertices), format_text("%.2f", m.times.total)});
   }
   t.print();
   std::printf("wall %.2f s, CPU %.2f s, peak memory %.0f MB\n", wall_seconds, cpu_seconds(), peak_rss_mb());
@@ -127,7 +127,7 @@ void print_transfer_summary(const pipeline::TransferResult& r, const pipeline::T
 
 void print_morph_summary(const pipeline::MorphResult& r, const pipeline::MorphJob& job) {
   std::printf("morph %s -> %s: %d frames of %lld vertices (%s) in %s\n", r.a.c_str(), r.b.c_str(), job.frames, r.vertices,
-              r.aligned ? strprintf("aligned: scale %.3f, rotation %.1f deg", r.scale, r.rotation_deg).c_str() : "not aligned",
+              r.aligned ? format_text("aligned: scale %.3f, rotation %.1f deg", r.scale, r.rotation_deg).c_str() : "not aligned",
               job.output.c_str());
 }
 
@@ -140,8 +140,8 @@ void print_pca_summary(const pipeline::PcaResult& result, const pipeline::PcaJob
   for (const Json& e : rep["errors"]) {
     const int k = e["components"].get<int>();
     if (k > 0) cumulative += rep["variance_fraction"][static_cast<std::size_t>(k - 1)].get<double>();
-    t.add_row({std::to_string(k), strprintf("%.3g", e["mean_rms"].get<double>()), strprintf("%.3g", e["max_rms"].get<double>()),
-               db_text(e["mean_psnr_db"]), strprintf("%.1f%%", 100 * cumulative)});
+    t.add_row({std::to_string(k), format_text("%.3g", e["mean_rms"].get<double>()), format_text("%.3g", e["max_rms"].get<double>()),
+               db_text(e["mean_psnr_db"]), format_text("%.1f%%", 100 * cumulative)});
   }
   t.print();
   if (!rep["compression"].empty()) {
@@ -149,8 +149,8 @@ void print_pca_summary(const pipeline::PcaResult& result, const pipeline::PcaJob
     for (const Json& p : rep["compression"]) {
       const int bits = p["bits"].get<int>();
       c.add_row({p["method"].get<std::string>(), p["method"] == "pca" ? std::to_string(p["components"].get<int>()) : "-",
-                 bits ? std::to_string(bits) : "f32", strprintf("%.0f", p["bytes_per_shape"].get<double>()),
-                 strprintf("%.0f", p["deflated_bytes_per_shape"].get<double>()), db_text(p["mean_psnr_db"])});
+                 bits ? std::to_string(bits) : "f32", format_text("%.0f", p["bytes_per_shape"].get<double>()),
+                 format_text("%.0f", p["deflated_bytes_per_shape"].get<double>()), db_text(p["mean_psnr_db"])});
     }
     c.print();
   }

@@ -27,6 +27,9 @@ Json mesh_check_json(const std::string& file, const MeshCheck& check);
 Json sphere_param_options_json(const SphereParamOptions& options);
 /// The constrained options as recorded in reports (the sphere options plus the network's).
 Json constrained_options_json(const ConstrainedParamOptions& options);
+/// The measures of a constrained map (efficiency, stretch, flips, winding, feature error,
+/// holes) as recorded in reports (param) and manifests (each member's "result").
+Json constrained_measures_json(const ConstrainedParamResult& result);
 /// The path network's statistics as recorded in reports.
 Json feature_network_json(const FeatureNetworkReport& network);
 /// The measures of a parameterize_sphere() result as recorded in reports (param, run).

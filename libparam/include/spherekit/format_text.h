@@ -1,12 +1,12 @@
-// printf-style formatting into a std::string for the jobs' messages and reports (g++ 12 has
-// no <format>). Internal to spherekit::pipeline.
+// printf-style formatting into a std::string (g++ 12 has no <format>), for messages and
+// reports: the one helper the libraries and the command line share.
 #pragma once
 
 #include <cstdarg>
 #include <cstdio>
 #include <string>
 
-namespace spherekit::pipeline::detail {
+namespace spherekit {
 
 inline std::string format_text(const char* format, ...) __attribute__((format(printf, 1, 2)));
 inline std::string format_text(const char* format, ...) {
@@ -22,4 +22,4 @@ inline std::string format_text(const char* format, ...) {
   return out;
 }
 
-}  // namespace spherekit::pipeline::detail
+}  // namespace spherekit

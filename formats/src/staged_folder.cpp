@@ -1,4 +1,5 @@
-// Staged folder writes (staged_folder.h): build beside, swap in once complete.
+// Staged folder writes (staged_folder.h): build beside, swap in once complete (atomically,
+// folder_swap.h).
 #include "spherekit/formats/staged_folder.h"
 
 #include <pthread.h>
@@ -9,6 +10,8 @@
 #include <system_error>
 
 #include "spherekit/formats/atomic_file.h"
+#include "spherekit/formats/folder_lock.h"
+#include "spherekit/formats/folder_swap.h"
 
 namespace fs = std::filesystem;
 
@@ -44,53 +47,37 @@ Status require_staged_folder_target(const std::string& dir, const std::string& m
 Status write_staged_folder(const std::string& dir, const std::string& marker,
                            const std::function<Status(const std::string&)>& write_into, const KeepGoingFn& keep_going) {
   SPHEREKIT_RETURN_IF_ERROR(require_staged_folder_target(dir, marker));
-  std::error_code ec;
-  const fs::path target = fs::absolute(dir, ec).lexically_normal();
-  const fs::path base = target.has_filename() ? target : target.parent_path();
-  // (append, not operator+: GCC 12 warns falsely about "." + std::string, -Wrestrict)
-  const std::string pid = std::to_string(::getpid());
-  const fs::path staging = base.parent_path() / std::string(".").append(base.filename().string()).append(".partial.").append(pid);
-  fs::remove_all(staging, ec);
-  if (!fs::create_directory(staging, ec))
-    return Status(ErrorCode::IoError, staging.string() + ": cannot create staging folder (" + ec.message() + ")");
+  // Leftovers of writers killed earlier first (folder_swap.h).
+  recover_folder(dir);
+  SPHEREKIT_ASSIGN_OR_RETURN(StagingFolder staging, StagingFolder::create(dir));
+  const bool collection = marker == "collection.json";
+  // A collection carries its lock file from the start, so that `add`s never race on creating it.
+  if (collection)
+    SPHEREKIT_RETURN_IF_ERROR(write_file_atomic((fs::path(staging.path()) / kFolderLockFile).string(), ""));
   // A cancellation while the files are written (the caller's keep_going) removes the
-  // staging folder here, instead of leaving it behind.
-  Status s = write_into(staging.string());
+  // staging folder (~StagingFolder), instead of leaving it behind.
+  Status s = write_into(staging.path());
   if (s.ok() && keep_going && !keep_going()) s = Status(ErrorCode::Cancelled, "cancelled");
-  if (!s.ok()) {
-    fs::remove_all(staging, ec);
-    return s;
-  }
-  // Swap: the old folder aside, the new one in, the old one removed. Readers see the old
-  // folder or the new one (a brief moment with none in between). SIGINT/SIGTERM wait
-  // until it is done: an exit between the renames would leave no folder at DIR, the old one
-  // hidden as .DIR.old.PID.
+  if (!s.ok()) return s;
+  // The swap: one atomic exchange (folder_swap.h), so that readers, and a kill -9 at any
+  // moment, find the old folder or the new one, never none. An `add` growing the old
+  // collection holds its lock around its manifest update: wait for it, so that its member is
+  // not written into a folder being replaced (it then finds the new folder and re-reads it).
+  // SIGINT/SIGTERM wait until the swap is done.
   sigset_t stop_signals, saved_mask;
   sigemptyset(&stop_signals);
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, &saved_mask);
-  const Status swapped = [&]() -> Status {
-    const fs::path old = base.parent_path() / std::string(".").append(base.filename().string()).append(".old.").append(pid);
-    const bool had_old = fs::exists(base, ec);
-    if (had_old) {
-      fs::remove_all(old, ec);
-      fs::rename(base, old, ec);
-      if (ec) {
-        fs::remove_all(staging, ec);
-        return Status(ErrorCode::IoError, dir + ": cannot replace the existing folder (" + ec.message() + ")");
-      }
+  Status swapped;
+  {
+    FolderLock old_lock;
+    if (collection && has_marker(dir, marker)) {
+      auto l = FolderLock::acquire(dir);
+      if (l.ok()) old_lock = std::move(l).value();
     }
-    fs::rename(staging, base, ec);
-    if (ec) {
-      const std::string why = ec.message();
-      if (had_old) fs::rename(old, base, ec);
-      fs::remove_all(staging, ec);
-      return Status(ErrorCode::IoError, dir + ": cannot move the new folder into place (" + why + ")");
-    }
-    if (had_old) fs::remove_all(old, ec);
-    return Status();
-  }();
+    swapped = staging.commit();
+  }
   pthread_sigmask(SIG_SETMASK, &saved_mask, nullptr);  // a pending signal ends the program here
   return swapped;
 }

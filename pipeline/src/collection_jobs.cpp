@@ -2,6 +2,7 @@
 // of a collection into its folder, and a new member mapped onto an existing collection's
 // feature locations.
 #include <algorithm>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
@@ -14,7 +15,9 @@
 #include "spherekit/formats/feature_io.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
+#include "spherekit/metrics.h"
 #include "spherekit/pipeline/collection.h"
+#include "spherekit/pipeline/collection_update.h"
 #include "spherekit/pipeline/json.h"
 #include "spherekit/version.h"
 #include "spherekit/format_text.h"
@@ -120,6 +123,47 @@ Status read_members(const MakeCollectionJob& a, MakeCollectionResult& out) {
   return Status();
 }
 
+// A map computed elsewhere (e.g. `param --features --targets DIR/features.txt` in a job) is
+// accepted only as add would have produced it: the mesh's vertices and faces, a bijection by
+// the exact predicate, every feature vertex on its location F_k (within require_exact's bound).
+Result<Json> verify_registered_map(const std::string& map_path, const TriMesh& mesh, const std::vector<int>& fv,
+                                   const std::vector<Eigen::Vector3d>& F, ConstrainedParamResult& out,
+                                   std::string& bytes) {
+  auto map = formats::read_sphere_map(map_path, mesh);
+  if (!map.ok()) return with_file(map.status(), map_path);
+  if (const int flipped = count_flipped_faces(mesh.F, map->S); flipped != 0)
+    return Status(ErrorCode::InvalidInput,
+                  format_text("%s: %d flipped or degenerate faces on the sphere (not a bijection)", map_path.c_str(), flipped));
+  double worst = 0;
+  for (size_t k = 0; k < fv.size(); ++k) {
+    const Eigen::Vector3d p = map->S.row(fv[k]).transpose();
+    worst = std::max(worst, std::atan2(p.cross(F[k]).norm(), p.dot(F[k])));
+  }
+  if (!(worst < 1e-9))
+    return Status(ErrorCode::InvalidInput,
+                  format_text("%s: a feature vertex is %.3g rad off the collection's location (a map to other locations?)",
+                              map_path.c_str(), worst));
+  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics m, evaluate_sphere_map(mesh, map->S));
+  SPHEREKIT_ASSIGN_OR_RETURN(bytes, formats::read_file(map_path));
+  out = ConstrainedParamResult{};
+  out.map = map.value();
+  out.efficiency = m.efficiency;
+  out.l2_stretch = m.l2_stretch;
+  out.linf_stretch = m.linf;
+  out.winding = m.winding;
+  out.max_feature_angle = worst;
+  Json j;
+  j["efficiency"] = m.efficiency;
+  j["l2_stretch"] = m.l2_stretch;
+  j["linf_stretch"] = m.linf;
+  j["flipped_faces"] = 0;
+  j["winding"] = m.winding;
+  j["max_feature_angle"] = worst;
+  j["method"] = map->provenance.method;
+  j["registered_from"] = absolute_path(map_path);
+  return j;
+}
+
 formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const ConsistentParamOptions& o,
                                         const std::string& refinement_failure) {
   const ConsistentParamResult& r = out.maps;
@@ -157,10 +201,10 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
                             {"joint_efficiency", r.joint_efficiency},
                             {"joint_flipped_faces", r.joint_flips},
                             {"remesh_vertices", r.remesh_vertices}};
-  man.extra["times"] = Json{{"step1_reference", r.times.reference}, {"step2_initial_maps", r.times.initial},
-                            {"step3_remesh", r.times.remesh},       {"step4_concatenate", r.times.concatenate},
-                            {"step5_joint_map", r.times.joint},     {"step6_final_maps", r.times.final_maps},
-                            {"total", r.times.total}};
+  // No times and no thread count (effort only): the same inputs give the same manifest bytes
+  // on any machine and in any job order (issue 23); consistent_times_json() has the times.
+  man.options.erase("threads");
+  sort_members(man);
   return man;
 }
 
@@ -170,9 +214,22 @@ Json map_entry_json(const ConstrainedParamResult& r) {
   Json j = constrained_measures_json(r);
   j["method"] = r.map.provenance.method;
   j["network"] = feature_network_json(r.network);
-  j["times"] = Json{{"network", r.times.network}, {"simplify", r.times.simplify},
-                    {"refine", r.times.refine},   {"total", r.times.total}};
   return j;
+}
+
+Json map_times_json(const ConstrainedParamResult& r) {
+  return Json{{"network", r.times.network}, {"simplify", r.times.simplify}, {"refine", r.times.refine},
+              {"total", r.times.total}};
+}
+
+Json consistent_times_json(const MakeCollectionResult& out) {
+  const ConsistentParamResult& r = out.maps;
+  Json t{{"step1_reference", r.times.reference}, {"step2_initial_maps", r.times.initial},
+         {"step3_remesh", r.times.remesh},       {"step4_concatenate", r.times.concatenate},
+         {"step5_joint_map", r.times.joint},     {"step6_final_maps", r.times.final_maps},
+         {"total", r.times.total}};
+  for (size_t i = 0; i < out.members.size() && i < r.maps.size(); ++i) t["members"][out.members[i].name] = map_times_json(r.maps[i]);
+  return t;
 }
 
 Result<MakeCollectionResult> make_collection(const MakeCollectionJob& a, const ProgressFn& progress,
@@ -249,21 +306,14 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
   if (existing >= 0 && !a.replace)
     return Status(ErrorCode::InvalidArgument, a.mesh + ": the collection already has a mesh named '" + name +
                                                   "' (use --name, or --replace to map it again)");
-  // Never grow a broken collection: every other member's map must be there and fit.
-  SPHEREKIT_RETURN_IF_ERROR(formats::check_member_maps(c, existing));
+  // Never grow a broken collection: every other member's map must be there. (Only there: add
+  // reads the manifest and F, no other member's map, so that growing a collection of n members
+  // costs O(1) reads per add, not O(n).)
+  SPHEREKIT_RETURN_IF_ERROR(check_member_maps_present(c, existing));
   const std::string lm = a.features.empty() ? default_features_path(a.mesh) : a.features;
   const int nv = static_cast<int>(mesh.V.rows());
   SPHEREKIT_ASSIGN_OR_RETURN(std::vector<int> fv, features_in_order(lm, nv, c.manifest.feature_names()));
-
-  ConstrainedParamOptions o = a.options;
-  // The collection's shape-defining settings, unless given here.
-  const Json& opt = c.manifest.options;
-  if (opt.is_object() && opt.contains("seed") && opt["seed"].is_number_unsigned() && !a.seed_given)
-    o.sphere.seed = opt["seed"].get<std::uint64_t>();
-  auto result = parameterize_sphere_constrained(mesh, fv, c.manifest.locations(), o, progress);
-  if (!result.ok()) return with_file(result.status(), a.mesh);
-  out.map = std::move(result).value();
-  SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
+  const std::vector<Eigen::Vector3d> F = c.manifest.locations();
 
   formats::CollectionMember e;
   e.name = name;
@@ -274,32 +324,39 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
   e.faces = mesh.F.rows();
   e.feature_vertices = std::vector<long long>(fv.begin(), fv.end());
   e.added = true;
-  e.result = map_entry_json(out.map);
-  out.manifest = c.manifest;
-  if (existing >= 0)
-    out.manifest.members[static_cast<size_t>(existing)] = std::move(e);
-  else
-    out.manifest.members.push_back(std::move(e));
-  // The map first, then the manifest that names it: a reader never sees a member without
-  // its map. If the manifest cannot be written, the map is put back as it was (--replace:
-  // the old one, which the manifest still describes; otherwise none).
-  out.map_path = (fs::path(a.dir) / (name + ".sphere.obj")).string();
-  const bool map_existed = fs::exists(out.map_path);
-  std::string old_map;
-  if (map_existed) {
-    SPHEREKIT_ASSIGN_OR_RETURN(old_map, formats::read_file(out.map_path));
+  MemberUpdate u;
+  u.replace = a.replace;
+  u.feature_names = c.manifest.feature_names();
+  u.locations = F;
+  std::string registered_bytes;
+  if (!a.map.empty()) {
+    SPHEREKIT_ASSIGN_OR_RETURN(e.result, verify_registered_map(a.map, mesh, fv, F, out.map, registered_bytes));
+    out.registered = true;
+    u.write_map = [&](const std::string& path) { return formats::write_file_atomic(path, registered_bytes); };
+  } else {
+    ConstrainedParamOptions o = a.options;
+    // The collection's shape-defining settings, unless given here.
+    const Json& opt = c.manifest.options;
+    if (opt.is_object() && opt.contains("seed") && opt["seed"].is_number_unsigned() && !a.seed_given)
+      o.sphere.seed = opt["seed"].get<std::uint64_t>();
+    auto result = parameterize_sphere_constrained(mesh, fv, F, o, progress);
+    if (!result.ok()) return with_file(result.status(), a.mesh);
+    out.map = std::move(result).value();
+    SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
+    e.result = map_entry_json(out.map);
+    u.write_map = [&](const std::string& path) { return formats::write_sphere_map(path, mesh, out.map.map); };
   }
-  SPHEREKIT_RETURN_IF_ERROR(formats::write_sphere_map(out.map_path, mesh, out.map.map));
-  if (Status s = formats::write_file_atomic((fs::path(a.dir) / formats::kCollectionManifest).string(),
-                                            formats::collection_manifest_text(out.manifest));
-      !s.ok()) {
-    std::error_code ec;
-    if (map_existed)
-      (void)formats::write_file_atomic(out.map_path, old_map);
-    else
-      fs::remove(out.map_path, ec);
+  u.member = std::move(e);
+  out.map_path = (fs::path(a.dir) / (name + ".sphere.obj")).string();
+  // The read-modify-write of the manifest, under the folder's lock (collection_update.h).
+  auto committed = commit_member(a.dir, u);
+  if (!committed.ok()) {
+    const Status& s = committed.status();
+    if (s.code() == ErrorCode::InvalidArgument)  // the name was taken meanwhile: name the mesh, as above
+      return Status(s.code(), a.mesh + ": " + s.message().substr(s.message().find(": ") + 2));
     return s;
   }
+  out.manifest = std::move(committed).value();
   out.vertices = nv;
   out.features = c.manifest.features.size();
   out.wall_seconds = wall.seconds();

@@ -42,7 +42,9 @@ using detail::SphereTriangulation;
 using detail::Tri;
 using detail::Vec3;
 
-constexpr int kMaxMembers = 8;
+// Eight hand-named members (sample_a..sample_h) for the demos; larger generated collections
+// (the scale tests and benchmarks of issue 23) continue with letter names, up to 1000.
+constexpr int kMaxMembers = 1000;
 constexpr int kMinVertices = 200;      // below this the limbs cannot be resolved
 constexpr int kMaxVertices = 200000;   // the hull and locate() are not built for more
 constexpr int kCorrSamples = 500;      // template points offered for the .corr.txt files
@@ -172,9 +174,23 @@ int nearest_vertex(const RowMat3d& template_points, const Vec3& u) {
   return static_cast<int>(best);
 }
 
+// sample_a .. sample_z, then sample_aa .. sample_zz, then three letters: k = 0..1000.
+std::string member_name(int k) {
+  int width = 1, count = 26;
+  while (k >= count && width < 3) {
+    k -= count;
+    count *= 26;
+    ++width;
+  }
+  std::string letters(static_cast<size_t>(width), 'a');
+  for (int i = width - 1; i >= 0; --i) {
+    letters[static_cast<size_t>(i)] = static_cast<char>('a' + k % 26);
+    k /= 26;
+  }
+  return "sample_" + letters;
+}
+
 Result<SampleMesh> make_member(int k, const SampleCollectionOptions& options) {
-  static const char* const kNames[kMaxMembers] = {"sample_a", "sample_b", "sample_c", "sample_d",
-                                                   "sample_e", "sample_f", "sample_g", "sample_h"};
   Rng rng(member_seed(options.seed, k));
   const detail::AnimalShape shape = detail::random_animal(rng);
   const auto kind = static_cast<Tessellation>(k % 4);
@@ -209,7 +225,7 @@ Result<SampleMesh> make_member(int k, const SampleCollectionOptions& options) {
   std::vector<Vec3> U = editor.U(), X = editor.X();
   std::vector<Tri> F = editor.F();
   SampleMesh member;
-  member.name = kNames[k];
+  member.name = member_name(k);
   if (k % 2 == 1) {
     SPHEREKIT_RETURN_IF_ERROR(
         cut_member_hole(U, X, F, k % 4 == 1 ? detail::mouth_cap() : detail::belly_cap(), fixed)
@@ -286,7 +302,7 @@ std::string format_xyz(double x, double y, double z) {
 
 Result<std::vector<SampleMesh>> make_sample_collection(const SampleCollectionOptions& options) {
   if (options.members < 1 || options.members > kMaxMembers)
-    return Status(ErrorCode::InvalidArgument, "sample collection: members must be in [1, 8], got " +
+    return Status(ErrorCode::InvalidArgument, "sample collection: members must be in [1, " + std::to_string(kMaxMembers) + "], got " +
                                                   std::to_string(options.members));
   if (options.target_vertices < kMinVertices || options.target_vertices > kMaxVertices)
     return Status(ErrorCode::InvalidArgument, "sample collection: target_vertices must be in [" +

@@ -27,7 +27,7 @@ struct SampleMesh {
 };
 
 struct SampleCollectionOptions {
-  int members = 4;             ///< how many shapes (1..8)
+  int members = 4;             ///< how many shapes (1..1000; names sample_a.., sample_aa.., sample_aaa..)
   int target_vertices = 3000;  ///< approximate vertex count per member
   std::uint64_t seed = 1;      ///< all shape and meshing randomness derives from this
 };

@@ -177,11 +177,13 @@ TEST_CASE("bad input: collection folders refused by add and correspond", "[cli][
       {"sphere map missing", [](const std::string& d) { fs::remove(d + "/sample_b.sphere.obj"); },
        {4, "sample_b.sphere.obj", "missing (the map of member 'sample_b'"},
        {4, "sample_b.sphere.obj", "missing (the map of member 'sample_b'"}},
+      // add reads no other member's map (O(1) reads per add, issue 23): a damaged map is the
+      // business of the commands that read it.
       {"sphere map with an extra vertex", replace_file("sample_b.sphere.obj", b_map + "v 1 0 0\n"),
-       {3, "sample_b.sphere.obj", "has " + std::to_string(b_vertices + 1) + " vertices"},
+       {0, "", ""},
        {3, "sample_b.sphere.obj", "has " + std::to_string(b_vertices + 1) + " vertices, mesh has " + nb}},
       {"vertex count in the manifest wrong", edit_manifest([](json& j) { j["meshes"][1]["vertices"] = 5; }),
-       {3, "sample_b.sphere.obj", "has " + nb + " vertices"},
+       {0, "", ""},
        // correspond reads B's mesh, which no longer matches its entry.
        {3, "sample_b.obj", "has " + nb + " vertices, but member 'sample_b'"}},
       {"features.txt missing", [](const std::string& d) { fs::remove(d + "/features.txt"); },
@@ -220,7 +222,15 @@ TEST_CASE("bad input: collection folders refused by add and correspond", "[cli][
 
     const std::string mesh = k.add_mesh.empty() ? c : k.add_mesh;
     CliRun r = sk("add " + q(col) + " " + q(mesh) + " --effort 0 -q", dir);
-    {
+    if (k.add.exit_code == 0) {
+      // Accepted (see the case); correspond below must still refuse the folder, which add
+      // grew by one member: compare against that.
+      INFO("add: " << r.err);
+      CHECK(r.exit_code == 0);
+      fs::remove_all(col);
+      fs::copy(good, col);
+      k.damage(col);
+    } else {
       INFO("add");
       require_failure(r, k.add.exit_code, k.add.file, k.add.problem);
       CHECK(snapshot(col) == before);

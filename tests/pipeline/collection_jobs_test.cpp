@@ -2,6 +2,7 @@
 // the folder they write reads back through formats, a failing mesh is named by its file (a
 // value, not an index in the text), and add never grows a collection it cannot use.
 #include <catch2/catch.hpp>
+#include <sys/stat.h>
 #include <filesystem>
 
 #include "sample_collection.h"
@@ -69,15 +70,34 @@ TEST_CASE("make_collection and add_to_collection: the folder formats reads", "[p
   // The collection's recorded seed was used (none was given).
   CHECK(grown->manifest.options["seed"] == made->manifest.options["seed"]);
 
-  SECTION("the same name again is refused unless replaced; a broken member map stops add") {
+  SECTION("the same name again is refused unless replaced; a missing member map stops add") {
     auto again = pipeline::add_to_collection(add);
     CHECK(again.status().code() == ErrorCode::InvalidArgument);
     CHECK(again.status().message().find("--replace") != std::string::npos);
-    REQUIRE(formats::write_mesh(dir + "/col/sample_a.sphere.obj", test::tetrahedron()).ok());
+    // add reads no other member's map (issue 23: O(1) reads per add), it only checks that each
+    // is there.
+    fs::remove(dir + "/col/sample_a.sphere.obj");
     add.replace = true;
     auto broken = pipeline::add_to_collection(add);
-    CHECK(broken.status().code() == ErrorCode::InvalidInput);
-    CHECK(broken.status().message().find("member 'sample_a'") != std::string::npos);
+    CHECK(broken.status().code() == ErrorCode::IoError);
+    CHECK(broken.status().message().find("missing (the map of member 'sample_a'") != std::string::npos);
+  }
+  SECTION("replace: a new version of the folder, the other maps hard-linked, the lock file kept") {
+    const std::string lock = dir + "/col/.collection.lock";
+    REQUIRE(fs::exists(lock));
+    // Waiters hold the lock file open: the new version must keep the same file (inode).
+    auto inode = [](const std::string& p) {
+      struct stat st {};
+      return ::stat(p.c_str(), &st) == 0 ? static_cast<long long>(st.st_ino) : -1LL;
+    };
+    const long long lock_inode = inode(lock);
+    add.replace = true;
+    auto replaced = pipeline::add_to_collection(add);
+    REQUIRE(replaced.ok());
+    CHECK(replaced->manifest.members.size() == 3);
+    CHECK(inode(lock) == lock_inode);
+    CHECK(lock_inode > 0);
+    for (const auto& e : fs::directory_iterator(dir)) CHECK(e.path().filename().string().rfind(".col.", 0) != 0);
   }
 }
 

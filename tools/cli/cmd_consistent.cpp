@@ -42,7 +42,10 @@ int run_consistent(const ConsistentArgs& a) {
   if (!a.report.empty()) {
     Json rep = formats::collection_manifest_json(r->manifest);
     rep["output"] = job.output;
+    // The manifest holds neither times nor the thread count (issue 23); the report does.
+    rep["times"] = pipeline::consistent_times_json(r.value());
     rep["times"]["wall"] = wall_seconds;
+    rep["options"]["threads"] = job.options.threads;
     rep["cpu_seconds"] = cpu_seconds();
     rep["peak_rss_mb"] = peak_rss_mb();
     if (Status s = write_json_atomic(a.report, rep); !s.ok()) return print_error(s);
@@ -53,12 +56,14 @@ int run_consistent(const ConsistentArgs& a) {
 
 struct AddArgs {
   pipeline::AddToCollectionJob job;
+  std::string report;
   bool quiet = false;
   SphereParamOptions sphere;
   ConstrainedFlags flags;
 };
 
 int run_add(const AddArgs& a) {
+  if (Status s = require_output_folders({a.report}); !s.ok()) return print_error(s);
   pipeline::AddToCollectionJob job = a.job;
   job.options = a.flags.resolve(a.sphere);
   job.seed_given = a.sphere.seed != SphereParamOptions{}.seed;
@@ -70,7 +75,20 @@ int run_add(const AddArgs& a) {
   progress.finish();
   if (cancel_requested()) return print_error(cancelled_status());
   if (!r.ok()) return print_error(r.status());
-  if (!a.quiet) {
+  if (!a.report.empty()) {
+    // Per-task measures (read by `submit --verify`): peak memory is per process.
+    Json rep{{"name", r->name}, {"map", r->map_path}, {"collection", job.dir}, {"registered", r->registered}};
+    if (!r->registered) rep["times"] = pipeline::map_times_json(r->map);
+    rep["times"]["wall"] = r->wall_seconds;
+    rep["cpu_seconds"] = cpu_seconds();
+    rep["peak_rss_mb"] = peak_rss_mb();
+    if (Status s = write_json_atomic(a.report, rep); !s.ok()) return print_error(s);
+  }
+  if (!a.quiet && r->registered) {
+    std::printf("%s -> %s (registered; %zu features on the collection's locations)\n", job.mesh.c_str(),
+                r->map_path.c_str(), r->features);
+    std::printf("  efficiency %.4f, max feature error %.2g rad\n", r->map.efficiency, r->map.max_feature_angle);
+  } else if (!a.quiet) {
     const ConstrainedParamResult& m = r->map;
     std::printf("%s -> %s (%zu features on the collection's locations)\n", job.mesh.c_str(), r->map_path.c_str(), r->features);
     std::printf("  efficiency %.4f, flipped faces %d, max feature error %.2g rad, %d paths, %d Steiner vertices\n",
@@ -122,14 +140,23 @@ void register_consistent(CLI::App& app) {
       "Constrained spherical parameterization of MESH with its features exactly on the collection's\n"
       "feature locations F (the paper's way to grow a database without recomputing it, §5). The\n"
       "feature file (default NAME.lm.txt beside the mesh) must name every feature of the\n"
-      "collection. Writes DIR/<stem>.sphere.obj and updates collection.json.",
+      "collection. Writes DIR/<stem>.sphere.obj and updates collection.json under the folder's lock\n"
+      "(DIR/.collection.lock, held only around the manifest update), so that concurrent adds, e.g. the\n"
+      "tasks of a job array, all land. Reads only the manifest and F, not the other members' maps.\n"
+      "Members are kept sorted by name.",
       "  spherekit add cats cat10.obj\n"
-      "  spherekit add cats scan.ply --features scan.lm.txt --name cat_scan");
+      "  spherekit add cats scan.ply --features scan.lm.txt --name cat_scan\n"
+      "  spherekit add cats cat11.obj --map cat11.sphere.obj   # computed elsewhere, verified");
   add->add_option("DIR", add_args->job.dir, "collection folder")->required();
   add->add_option("MESH", add_args->job.mesh, "mesh to add")->required();
   add->add_option("--features", add_args->job.features, "its feature file (default: MESH stem + .lm.txt)");
   add->add_option("--name", add_args->job.name, "member name (default: the mesh's file stem)");
   add->add_flag("--replace", add_args->job.replace, "map again if the collection has a member of that name");
+  add->add_option("--map", add_args->job.map,
+                  "register this sphere map (computed elsewhere, e.g. by 'param --features F.lm.txt --targets "
+                  "DIR/features.txt') instead of computing one; verified: same vertices and faces, bijective by the "
+                  "exact predicate, every feature on its location");
+  add->add_option("--report", add_args->report, "also write a JSON report (times, peak memory) here");
   add->add_flag("-q,--quiet", add_args->quiet, "print neither progress nor the summary (errors still)");
   add_sphere_param_options(*add, add_args->sphere);
   add_constrained_flags(*add, add_args->flags);

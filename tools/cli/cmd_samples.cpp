@@ -48,7 +48,7 @@ void register_samples(CLI::App& app) {
       "  spherekit samples -o samples\n"
       "  spherekit samples -o big --members 8 --vertices 20000 --seed 7");
   cmd->add_option("-o,--output", args->output, "folder to write (created if missing)")->required();
-  cmd->add_option("--members", args->options.members, "how many shapes")->check(CLI::Range(1, 8))->capture_default_str();
+  cmd->add_option("--members", args->options.members, "how many shapes")->check(CLI::Range(1, 1000))->capture_default_str();
   cmd->add_option("--target-vertices", args->options.target_vertices, "approximate vertex count per shape")
       ->check(CLI::Range(100, 10000000))->capture_default_str();
   cmd->add_option("--vertices", args->options.target_vertices)->check(CLI::Range(100, 10000000))->group("");

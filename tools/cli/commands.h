@@ -41,6 +41,7 @@ void register_correspond(CLI::App& app);  // cmd_correspond.cpp: point transfer 
 void register_transfer(CLI::App& app);    // cmd_transfer.cpp: colours/normals/uv/texture A -> B
 void register_morph(CLI::App& app);       // cmd_morph.cpp:    morph sequence between two members
 void register_pca(CLI::App& app);         // cmd_pca.cpp:      mean shape, components, errors, compression
+void register_submit(CLI::App& app);      // cmd_submit.cpp:   large collections as job arrays (local or Slurm)
 
 /// The summary `convert` prints for one mesh.
 void print_mesh_summary(const pipeline::ConvertMeshResult& result);

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   cli::register_transfer(app);
   cli::register_morph(app);
   cli::register_pca(app);
+  cli::register_submit(app);
 
   try {
     // The chosen subcommand's callback runs inside parse() and records its exit code.

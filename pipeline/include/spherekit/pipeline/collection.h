@@ -56,6 +56,11 @@ struct AddToCollectionJob {
   std::string features;  ///< its landmark file (empty: NAME.lm.txt beside it)
   std::string name;      ///< member name (empty: the mesh's file stem)
   bool replace = false;  ///< map again if the collection has a member of that name
+  /// A sphere map computed elsewhere to register instead of computing one (e.g. `param
+  /// --features F.lm.txt --targets DIR/features.txt` in a job): verified to have the mesh's
+  /// vertices and faces, 0 flipped faces by the exact predicate and every feature within
+  /// 1e-9 rad of its location; its bytes are copied. Empty: compute the map.
+  std::string map;
   /// The constrained stage's options. The collection's recorded seed is used unless
   /// `seed_given` (the caller chose one).
   ConstrainedParamOptions options;
@@ -66,17 +71,24 @@ struct AddToCollectionResult {
   std::string name, map_path;
   long long vertices = 0;
   std::size_t features = 0;
-  ConstrainedParamResult map;
+  ConstrainedParamResult map;  ///< registered: the map and its measures only (no network, no times)
+  bool registered = false;
   formats::CollectionManifest manifest;  ///< as written
   double wall_seconds = 0;
 };
 
-/// Maps the mesh with its features exactly on the collection's locations F, writes
-/// DIR/<name>.sphere.obj, then the manifest naming it (the map is put back as it was when the
-/// manifest cannot be written). Never grows a broken collection (formats::check_member_maps).
+/// Maps the mesh with its features exactly on the collection's locations F (or registers
+/// `map`), then, under the folder's lock, re-reads the manifest, writes DIR/<name>.sphere.obj
+/// and the manifest naming it, members sorted by name (commit_member(), collection_update.h:
+/// concurrent adds all land). Reads only the manifest and F: the other members' maps are only
+/// checked to exist (check_member_maps_present).
 Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& job, const ProgressFn& progress = {});
 
-/// A member's entry "result" in the manifest: the measures of its map.
+/// A member's entry "result" in the manifest: the measures of its map (no times: see below).
 Json map_entry_json(const ConstrainedParamResult& r);
+/// A map's times (for reports; the manifest holds none).
+Json map_times_json(const ConstrainedParamResult& r);
+/// The six steps' times and each member's map times (for `consistent --report`).
+Json consistent_times_json(const MakeCollectionResult& out);
 
 }  // namespace spherekit::pipeline

@@ -54,6 +54,7 @@ class Simplifier {
   Simplifier(const RowMatXd& P, const RowMat3i& F, const ProgressiveMeshOptions& opt)
       : P_(P), opt_(opt), d_(static_cast<int>(P.cols())), nv_(static_cast<int>(P.rows())) {
     const int nf = static_cast<int>(F.rows());
+    build_quadric_coordinates(F);
     faces_.resize(static_cast<size_t>(nf));
     face_alive_.assign(static_cast<size_t>(nf), 1);
     vf_.resize(static_cast<size_t>(nv_));
@@ -65,13 +66,13 @@ class Simplifier {
     }
     vertex_alive_.assign(static_cast<size_t>(nv_), 1);
     stamp_.assign(static_cast<size_t>(nv_), 0);
-    quadric_.assign(static_cast<size_t>(nv_), detail::QuadricND(d_));
+    quadric_.assign(static_cast<size_t>(nv_), detail::QuadricND(qd_));
     area_.assign(static_cast<size_t>(nv_), 0.0);
     for (int f = 0; f < nf; ++f) {
       double w = opt_.face_weights.empty() ? 1.0 : opt_.face_weights[static_cast<size_t>(f)];
       double area = face_area(faces_[f]) * w;
-      detail::QuadricND q(d_);
-      q.add_triangle(P_.row(F(f, 0)).data(), P_.row(F(f, 1)).data(), P_.row(F(f, 2)).data(), area);
+      detail::QuadricND q(qd_);
+      q.add_triangle(X_.row(F(f, 0)).data(), X_.row(F(f, 1)).data(), X_.row(F(f, 2)).data(), area);
       for (int k = 0; k < 3; ++k) {
         quadric_[static_cast<size_t>(F(f, k))].add(q);
         area_[static_cast<size_t>(F(f, k))] += area / 3.0;
@@ -140,10 +141,69 @@ class Simplifier {
     return a;
   }
 
+  // Quadric coordinates: the positions, and with normal_weight > 0 each model's unit vertex
+  // normals times that weight (Garland & Heckbert 1998's attribute quadrics; Hoppe 1999's
+  // normal term, which MeshSimplify's -minqem uses with 0.02 x the diagonal). Around a thin
+  // limb the normals turn through every direction within a small distance, so collapsing it
+  // costs about weight^2 instead of radius^2: limbs survive to coarse levels, where the
+  // sphere layout is decided, instead of being re-inserted late into a tiny patch.
+  void build_quadric_coordinates(const RowMat3i& F) {
+    const int models = d_ / 3;
+    const bool normals = opt_.normal_weight > 0;
+    qd_ = normals ? 2 * d_ : d_;
+    X_.resize(nv_, qd_);
+    X_.leftCols(d_) = P_;
+    if (!normals) return;
+    RowMatXd N = RowMatXd::Zero(nv_, d_);
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (int m = 0; m < models; ++m) {
+        Eigen::Vector3d p0 = P_.row(F(f, 0)).segment<3>(3 * m).transpose();
+        Eigen::Vector3d p1 = P_.row(F(f, 1)).segment<3>(3 * m).transpose();
+        Eigen::Vector3d p2 = P_.row(F(f, 2)).segment<3>(3 * m).transpose();
+        const Eigen::RowVector3d n = (p1 - p0).cross(p2 - p0).transpose();  // area weighted
+        for (int k = 0; k < 3; ++k) N.row(F(f, k)).segment<3>(3 * m) += n;
+      }
+    for (int v = 0; v < nv_; ++v)
+      for (int m = 0; m < models; ++m) {
+        auto n = N.row(v).segment<3>(3 * m);
+        const double len = n.norm();
+        if (len > 0) n /= len;
+      }
+    X_.rightCols(d_) = opt_.normal_weight * N;
+  }
+
+  // Memoryless quadric (Lindstrom & Turk 1998; MeshSimplify -minqem): the area-weighted
+  // squared distances of vs's point to the planes of the faces now around vt (those around
+  // vs contain it). It measures the current level, not the original surface, so coarse
+  // levels keep what is still visible at their scale.
+  double memoryless_error(int vt, int vs) const {
+    const int d = qd_;
+    const double* x = X_.row(vs).data();
+    double sum = 0;
+    for (int f : vf_[vt]) {
+      const auto& c = faces_[f];
+      const double* x0 = X_.row(c[0]).data();
+      const double* x1 = X_.row(c[1]).data();
+      const double* x2 = X_.row(c[2]).data();
+      double e1e1 = 0, e1e2 = 0, e2e2 = 0, re1 = 0, re2 = 0, rr = 0;
+      for (int i = 0; i < d; ++i) {
+        const double e1 = x1[i] - x0[i], e2 = x2[i] - x0[i], r = x[i] - x0[i];
+        e1e1 += e1 * e1, e1e2 += e1 * e2, e2e2 += e2 * e2, re1 += r * e1, re2 += r * e2, rr += r * r;
+      }
+      const double det = e1e1 * e2e2 - e1e2 * e1e2;
+      if (!(det > 1e-24 * e1e1 * e2e2)) continue;
+      // Squared distance to the 2-plane: |r|^2 - r^T E (E^T E)^-1 E^T r.
+      const double proj = (e2e2 * re1 * re1 - 2 * e1e2 * re1 * re2 + e1e1 * re2 * re2) / det;
+      sum += face_area(c) * std::max(0.0, rr - proj);
+    }
+    return sum;
+  }
+
   double cost(int vt, int vs) const {
     const double* ps = P_.row(vs).data();
     const double* pt = P_.row(vt).data();
-    double q = quadric_[vt].evaluate(ps) + quadric_[vs].evaluate(ps);
+    const double* xs = X_.row(vs).data();
+    double q = opt_.memoryless ? memoryless_error(vt, vs) : quadric_[vt].evaluate(xs) + quadric_[vs].evaluate(xs);
     double len2 = 0;
     for (int i = 0; i < d_; ++i) len2 += (ps[i] - pt[i]) * (ps[i] - pt[i]);
     return q + opt_.edge_length_weight * len2 * area_[vt];
@@ -275,19 +335,31 @@ class Simplifier {
         if (x == vt) x = vs;
       pt.clear();
     }
-    quadric_[vs].add(quadric_[vt]);
+    if (!opt_.memoryless) quadric_[vs].add(quadric_[vt]);
     area_[vs] += area_[vt];
     ++stamp_[vs];
     if (forced) ++pm.forced_collapses;
     pm.collapses.push_back(rec);
     neighbours(vs, ns_);
-    for (int w : ns_) push_edge(vs, w);
+    if (opt_.memoryless) {
+      // The faces of vs's neighbours changed too: so did the costs of all their edges.
+      for (int w : ns_) ++stamp_[w];
+      std::vector<int> ring;
+      for (int w : ns_) {
+        neighbours(w, ring);
+        for (int x : ring) push_edge(w, x);
+      }
+    } else {
+      for (int w : ns_) push_edge(vs, w);
+    }
     return true;
   }
 
   const RowMatXd& P_;
   const ProgressiveMeshOptions& opt_;
   int d_, nv_;
+  int qd_ = 0;   // quadric dimension: d_, or 2 d_ with normals
+  RowMatXd X_;   // quadric coordinates per vertex (positions, weighted normals)
   int alive_count_ = 0;
   std::vector<std::array<int, 3>> faces_;
   std::vector<char> face_alive_, vertex_alive_;

@@ -13,6 +13,8 @@
 #include <cmath>
 #include <string>
 
+#include "detail/parallel_jobs.h"
+#include "detail/worker_pool.h"
 #include "spherekit/predicates.h"
 
 namespace spherekit::detail {
@@ -115,7 +117,7 @@ bool kernel_near_vertex(const RingScratch& ring, const Eigen::Vector3d& vs, Eige
 class Refiner {
  public:
   Refiner(const EmbedInput& in, const OptimizerSettings& s, const ProgressFn& progress, EmbedStats* stats)
-      : in_(in), pm_(*in.pm), s_(s), progress_(progress), stats_(stats) {}
+      : in_(in), pm_(*in.pm), s_(s), progress_(progress), stats_(stats), pool_(resolve_threads(s.threads)) {}
 
   Status run(RowMat3d* S) {
     init_base_level();
@@ -278,9 +280,9 @@ class Refiner {
     st_.update_areas();
     for (int g = 0; g < s.global_iter; ++g) {
       std::uint64_t pass_key = s_.seed * 0xd1b54a32d192ed03ULL + static_cast<std::uint64_t>(stats_->passes) * 0x8cb92ba72f3d8dd7ULL;
-      int rounds = optimize_all(st_, s, pass_key, [&] {
-        return report_progress(progress_, "optimize", st_.alive_vertices, -1.0);
-      });
+      int rounds = optimize_all(
+          st_, s, pass_key, [&] { return report_progress(progress_, "optimize", st_.alive_vertices, -1.0); },
+          &pool_);
       if (rounds < 0) return Status(ErrorCode::Cancelled, "cancelled during optimization");
       ++stats_->passes;
       stats_->rounds += rounds;
@@ -295,6 +297,7 @@ class Refiner {
   EmbedStats* stats_;
   SphereState st_;
   RingScratch ring_;
+  WorkerPool pool_;  // one set of threads for every pass of the run
 };
 
 }  // namespace

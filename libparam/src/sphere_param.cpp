@@ -83,6 +83,12 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   // 4. Progressive mesh down to a tetrahedron.
   auto t0 = std::chrono::steady_clock::now();
   ProgressiveMeshOptions pmo;
+  // The reference's simplification (MeshSimplify -minqem, REFERENCE.md §2.1): memoryless
+  // quadrics with the vertex normals at 0.02 x the diagonal (P has a unit diagonal). Thin
+  // limbs then survive to the coarse levels, which decide how much of the sphere they get
+  // (issue 20: tentacle blob 0.1127 -> 0.1272 with the same optimizer).
+  pmo.normal_weight = 0.02;
+  pmo.memoryless = true;
   // Hole faces take full part in the simplification (only the optimizer down-weights
   // them, as the reference does): their geometry shapes the coarse levels like any other.
   SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, closed.F, pmo, progress));

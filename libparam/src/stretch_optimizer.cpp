@@ -22,13 +22,9 @@
 #include <limits>
 
 #include "detail/sphere_state.h"
+#include "detail/worker_pool.h"
 #include "spherekit/predicates.h"
 
-#ifdef _OPENMP
-#include <omp.h>
-#else
-static int omp_get_max_threads() { return 1; }
-#endif
 
 namespace spherekit::detail {
 namespace {
@@ -207,14 +203,17 @@ OptimizerSettings settings_for_effort(int effort) {
   // great circles), which reach the same efficiency with fewer energy evaluations, and so
   // effort 2 needs two passes per level instead of three (measured on the shared dev meshes:
   // same efficiency within 0.002, about 35% less work). Effort 2 also judges convergence
-  // relative to the local triangle size (movetol_rel), which spends the saved work where
-  // triangles are small on the sphere (thin limbs), at an absolute cap of 5e-4.
+  // relative to the local triangle size alone (movetol_rel; no absolute cap, movetol = 1):
+  // a vertex is converged when its moves are small against its own triangles, so coarse
+  // levels (half the work before) stop at their own precision and the work goes where
+  // triangles are small on the sphere (thin limbs). Issue 20, generated limb shapes: an
+  // absolute cap of 5e-4 doubled the CPU time for the same efficiency (0.3529 vs 0.3530).
   OptimizerSettings s;
   s.newton = true;
   switch (std::clamp(effort, 0, 5)) {
     case 0: s.line_search_iter = 6;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 1e-2; s.nv_ratio = 1.7;  break;
     case 1: s.line_search_iter = 8;   s.vsplit_vt_iter = 1; s.vsplit_nei_iter = 0;  s.global_iter = 1;  s.movetol = 5e-3; s.nv_ratio = 1.25; break;
-    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 5e-4; s.nv_ratio = 1.2;  s.movetol_rel = 0.02; break;
+    case 2: s.line_search_iter = 10;  s.vsplit_vt_iter = 2; s.vsplit_nei_iter = 0;  s.global_iter = 2;  s.movetol = 1.0;  s.nv_ratio = 1.2;  s.movetol_rel = 0.02; break;
     case 3: s.line_search_iter = 40;  s.vsplit_vt_iter = 3; s.vsplit_nei_iter = 3;  s.global_iter = 5;  s.movetol = 1e-3; s.nv_ratio = 1.1;  break;
     case 4: s.line_search_iter = 100; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 5;  s.global_iter = 8;  s.movetol = 5e-4; s.nv_ratio = 1.05; break;
     default: s.line_search_iter = 200; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 20; s.global_iter = 20; s.movetol = 3e-4; s.nv_ratio = 1.04; break;
@@ -497,12 +496,13 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
 }
 
 int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
-                 const std::function<bool()>& keep_going) {
+                 const std::function<bool()>& keep_going, WorkerPool* pool) {
   const int nv = static_cast<int>(st.S.rows());
+  auto is_fixed = [&](int v) { return !st.fixed.empty() && st.fixed[static_cast<size_t>(v)]; };
   std::vector<double> credit(static_cast<size_t>(nv), 0.0);
   std::vector<int> active;
   for (int v = 0; v < nv; ++v)
-    if (st.vertex_alive[static_cast<size_t>(v)] && !(st.fixed.size() && st.fixed[static_cast<size_t>(v)])) {
+    if (st.vertex_alive[static_cast<size_t>(v)] && !is_fixed(v)) {
       credit[static_cast<size_t>(v)] = 3.0;
       active.push_back(v);
     }
@@ -511,86 +511,100 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
     double dist;
     bool moved;
   };
+  WorkerPool serial(1);
+  WorkerPool& workers = pool ? *pool : serial;
+  std::vector<RingScratch> rings(static_cast<size_t>(workers.threads()));
   std::vector<Candidate> cand;
-  std::vector<char> locked(static_cast<size_t>(nv), 0);
-  std::vector<int> order, next;
-  int threads = s.threads > 0 ? s.threads : 0;
+  // Per-vertex marks instead of arrays cleared every round: a round costs time in
+  // proportion to its active vertices, not to the mesh (late rounds have a few dozen).
+  std::vector<int> locked_in(static_cast<size_t>(nv), -1), listed_in(static_cast<size_t>(nv), -1);
+  std::vector<int> order, next, keep;
   int round = 0;
   for (; round < s.max_rounds && !active.empty(); ++round) {
     if (keep_going && !keep_going()) return -1;
-    cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
     const int na = static_cast<int>(active.size());
+    cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
     // Candidates are computed from the same positions by every thread: results do not
     // depend on the thread count or scheduling.
-#pragma omp parallel num_threads(threads > 0 ? threads : omp_get_max_threads()) if (na > 256)
-    {
-      RingScratch ring;
-#pragma omp for schedule(dynamic, 64)
-      for (int i = 0; i < na; ++i) {
-        int v = active[static_cast<size_t>(i)];
-        std::uint64_t key = mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
-        Eigen::Vector3d y;
-        if (optimize_vertex(st, v, key, s, ring, &y, 2)) {
-          cand[static_cast<size_t>(i)].x = y;
-          cand[static_cast<size_t>(i)].dist = (y - st.S.row(v).transpose()).norm();
-          cand[static_cast<size_t>(i)].moved = true;
-        }
+    workers.parallel_for(na, 16, 64, [&](int i, int thread) {
+      const int v = active[static_cast<size_t>(i)];
+      const std::uint64_t key =
+          mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
+      Eigen::Vector3d y;
+      if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
+        Candidate& c = cand[static_cast<size_t>(i)];
+        c.x = y;
+        c.dist = (y - st.S.row(v).transpose()).norm();
+        c.moved = true;
       }
-    }
+    });
     // Apply greedily as an independent set, largest displacement first (ties by id).
-    order.resize(active.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    order.clear();
+    for (int i = 0; i < na; ++i)
+      if (cand[static_cast<size_t>(i)].moved) order.push_back(i);
     std::sort(order.begin(), order.end(), [&](int a, int b) {
       if (cand[a].dist != cand[b].dist) return cand[a].dist > cand[b].dist;
       return active[a] < active[b];
     });
-    std::fill(locked.begin(), locked.end(), 0);
+    next.clear();
+    for (int i = 0; i < na; ++i) {
+      const int v = active[static_cast<size_t>(i)];
+      listed_in[static_cast<size_t>(v)] = round;
+      next.push_back(v);
+    }
+    const int actives_listed = na;
     for (int i : order) {
-      int v = active[static_cast<size_t>(i)];
-      if (locked[static_cast<size_t>(v)]) continue;  // a neighbour moved: retry next round
+      const int v = active[static_cast<size_t>(i)];
+      if (locked_in[static_cast<size_t>(v)] == round) continue;  // a neighbour moved: retry next round
       credit[static_cast<size_t>(v)] = 0;
-      if (!cand[static_cast<size_t>(i)].moved) continue;
       st.S.row(v) = cand[static_cast<size_t>(i)].x.transpose();
       for (int f : st.vf[static_cast<size_t>(v)])
         for (int k = 0; k < 3; ++k) {
-          int w = st.F[static_cast<size_t>(f)][k];
+          const int w = st.F[static_cast<size_t>(f)][k];
           if (w == v) continue;
-          locked[static_cast<size_t>(w)] = 1;
+          locked_in[static_cast<size_t>(w)] = round;
           // "Spatial fade": neighbours of a moved vertex gain credit (REFERENCE.md §2.5).
           credit[static_cast<size_t>(w)] += 0.3 * cand[static_cast<size_t>(i)].dist / 2.0;
+          if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {
+            listed_in[static_cast<size_t>(w)] = round;
+            next.push_back(w);  // may have gained enough credit
+          }
         }
+    }
+    for (int i = 0; i < na; ++i) {
+      const int v = active[static_cast<size_t>(i)];
+      if (locked_in[static_cast<size_t>(v)] != round) credit[static_cast<size_t>(v)] = 0;  // moved, or converged
     }
     // Activity threshold: absolute (the reference's movetol), or relative to the vertex's
     // shortest chord to a neighbour, so that convergence is judged at the scale of the local
     // triangles: coarse levels stop sooner, compressed regions (thin legs) are refined longer.
-    auto tol = [&](int v) {
-      if (!(s.movetol_rel > 0)) return s.movetol;
-      double shortest = kInf;
-      const Eigen::Vector3d x = st.S.row(v).transpose();
-      for (int f : st.vf[static_cast<size_t>(v)])
-        for (int k = 0; k < 3; ++k) {
-          int w = st.F[static_cast<size_t>(f)][k];
-          if (w != v) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
-        }
-      return std::min(s.movetol, s.movetol_rel * shortest);
-    };
-    next.clear();
-    for (int v : active)
-      if (locked[static_cast<size_t>(v)] || credit[static_cast<size_t>(v)] > tol(v)) next.push_back(v);
-    // Neighbours of movers that were inactive may have gained enough credit.
-    for (int i : order) {
-      if (!cand[static_cast<size_t>(i)].moved) continue;
-      int v = active[static_cast<size_t>(i)];
-      for (int f : st.vf[static_cast<size_t>(v)])
-        for (int k = 0; k < 3; ++k) {
-          int w = st.F[static_cast<size_t>(f)][k];
-          if (w != v && !(st.fixed.size() && st.fixed[static_cast<size_t>(w)]) && credit[static_cast<size_t>(w)] > tol(w))
-            next.push_back(w);
-        }
-    }
-    std::sort(next.begin(), next.end());
-    next.erase(std::unique(next.begin(), next.end()), next.end());
-    active.swap(next);
+    // Judged in parallel (a ring walk per vertex) into per-slot flags.
+    // An active vertex that was locked (its move not applied) stays active; a neighbour of a
+    // mover joins only if its credit is above the threshold.
+    keep.assign(next.size(), 0);
+    workers.parallel_for(static_cast<int>(next.size()), 64, 256, [&](int j, int) {
+      const int v = next[static_cast<size_t>(j)];
+      if (j < actives_listed && locked_in[static_cast<size_t>(v)] == round) {
+        keep[static_cast<size_t>(j)] = 1;
+        return;
+      }
+      double tol = s.movetol;
+      if (s.movetol_rel > 0) {
+        double shortest = kInf;
+        const Eigen::Vector3d x = st.S.row(v).transpose();
+        for (int f : st.vf[static_cast<size_t>(v)])
+          for (int k = 0; k < 3; ++k) {
+            const int w = st.F[static_cast<size_t>(f)][k];
+            if (w != v) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
+          }
+        tol = std::min(s.movetol, s.movetol_rel * shortest);
+      }
+      keep[static_cast<size_t>(j)] = credit[static_cast<size_t>(v)] > tol ? 1 : 0;
+    });
+    active.clear();
+    for (size_t j = 0; j < next.size(); ++j)
+      if (keep[j]) active.push_back(next[j]);
+    std::sort(active.begin(), active.end());
   }
   return round;
 }

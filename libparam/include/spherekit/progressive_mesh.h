@@ -53,6 +53,14 @@ struct ProgressiveMeshOptions {
   /// Relative weight of the squared edge length added to the quadric cost; it breaks the
   /// ties QEM leaves in flat regions in favour of short edges (better-shaped levels).
   double edge_length_weight = 0.01;
+  /// Weight of the vertex normals in the quadric (0 = positions only), in units of the
+  /// coordinates: with positions normalized to a unit bounding-box diagonal, 0.02 is
+  /// MeshSimplify's (Hoppe 1999) normal term. Keeps thin limbs to coarse levels.
+  double normal_weight = 0;
+  /// Memoryless quadrics (Lindstrom & Turk 1998): a collapse costs the distances to the
+  /// planes of the faces around it at the current level, instead of quadrics accumulated
+  /// from the original faces.
+  bool memoryless = false;
 };
 
 /// Builds the progressive mesh of a closed, manifold, genus-0 triangle mesh whose vertex

@@ -12,6 +12,8 @@
 
 namespace spherekit::detail {
 
+class WorkerPool;
+
 struct SphereState {
   const RowMatXd* P = nullptr;  ///< #V by 3m surface positions (m models; m = 1 normally)
   int models = 1;
@@ -52,8 +54,13 @@ struct OptimizerSettings {
   double regularizer_weight = 1e-4;
   /// Faces whose chord plane passes closer than this to the centre (large spherical
   /// triangles) are evaluated with Praun & Hoppe's accordion split; the final full-resolution
-  /// pass sets 0 and optimizes exactly the measured chord-triangle stretch.
-  double split_distance = 0.9;
+  /// pass sets 0 and optimizes exactly the measured chord-triangle stretch. 0.99 splits
+  /// every face wider than about 8 degrees (circumradius), i.e. all faces of the coarse
+  /// levels, where the layout of thin limbs is decided: there the bulge of a spherical
+  /// triangle over its chord is large, and leaving it out (0.9: only faces above 26
+  /// degrees) let limbs end compressed (issue 20: tentacle blob 0.1252 -> 0.1327, the
+  /// reference 0.1321).
+  double split_distance = 0.99;
   bool newton = false;         ///< vertex moves by safeguarded Newton steps (else Brent searches)
   std::uint64_t seed = 1;
   int threads = 0;             ///< 0 = hardware concurrency
@@ -107,8 +114,9 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
 /// A global pass (Praun & Hoppe 2003 / REFERENCE.md §2.5): rounds in which all active
 /// vertices compute a move in parallel from the current positions, then moves are applied
 /// greedily as an independent set (largest first). Deterministic for any thread count.
-/// Returns the number of rounds, or -1 if cancelled by `keep_going`.
+/// Returns the number of rounds, or -1 if cancelled by `keep_going`. `pool` runs the
+/// candidate moves (null: on the calling thread only).
 int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
-                 const std::function<bool()>& keep_going);
+                 const std::function<bool()>& keep_going, WorkerPool* pool = nullptr);
 
 }  // namespace spherekit::detail

@@ -434,3 +434,39 @@ TEST_CASE("run maps given meshes and reports failures but keeps going", "[cli]")
 
 // The main job on the built-in samples (run without meshes) is tested with its results page
 // in site_page_test.cpp.
+
+// bench --reference-dir runs the reference's pipeline script after ours on each mesh and
+// compares with what it measured in the same run. The stand-in "reference" here is a script
+// that runs this same spherekit (deterministic), so both rows must agree exactly; the real
+// kit (shared/anchors/mpl) is exercised by hand, its build takes minutes.
+TEST_CASE("bench compares with a reference measured in the same run", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_bench_reference");
+  const std::string mesh = write_obj(dir, "blob.obj", spherekit::test::random_blob(2, 5));
+  const std::string kit = dir + "/mpl";
+  fs::create_directories(kit + "/bin/unix");
+  write_text(kit + "/bin/unix/SphereParam", "#!/bin/sh\nexit 1\n");
+  const std::string script = dir + "/fake_sphereparam.sh";
+  write_text(script, "#!/bin/bash\n[[ -n $MPL_ROOT && -n $OMP_NUM_THREADS ]] || exit 9\nexec " +
+                         quote(SPHEREKIT_EXE) + " param \"$1\" -o \"$2\" --quiet\n");
+  const std::string out = dir + "/bench.json";
+  CliRun r = run_cli("bench " + quote(mesh) + " --reference-dir " + quote(kit) + " --reference-script " +
+                         quote(script) + " --threads 1 -o " + quote(out),
+                     dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("measured in this run") != std::string::npos);
+  json j = parse_json(slurp(out));
+  REQUIRE(j["rows"].size() == 1);
+  const json& row = j["rows"][0];
+  REQUIRE(row.contains("reference"));
+  CHECK(row["reference"]["efficiency"].get<double>() == Approx(row["efficiency"].get<double>()).epsilon(1e-9));
+  CHECK(row["reference"]["cpu_seconds"].get<double>() > 0);
+  CHECK(j["totals"]["cpu_ratio"].get<double>() > 0);
+
+  // A folder without the reference's programs: one-line error naming it, no output.
+  const std::string out2 = dir + "/bench2.json";
+  CliRun bad = run_cli("bench " + quote(mesh) + " --reference-dir " + quote(dir + "/nowhere") + " -o " + quote(out2), dir);
+  CHECK(bad.exit_code != 0);
+  CHECK(bad.err.find("nowhere") != std::string::npos);
+  CHECK_FALSE(fs::exists(out2));
+}

@@ -1,5 +1,6 @@
 // `spherekit bench`: time, peak memory and efficiency of `param` per mesh, side by side
-// with the reference implementation's figures (shared/docs/EVALUATION.md §4).
+// with the reference implementation: run in the same session (--reference-dir), else its
+// figures recorded in shared/docs/EVALUATION.md §4.
 //
 // Each mesh runs in a child process (`spherekit param ... --report`), so CPU time and peak
 // resident memory are the mesh's own, measured by the kernel (wait4), not accumulated over
@@ -27,6 +28,9 @@
 #include "commands.h"
 #include "sample_collection.h"
 #include "spherekit/formats/atomic_file.h"
+#include "spherekit/file_status.h"
+#include "spherekit/formats/mesh_io.h"
+#include "spherekit/metrics.h"
 #include "spherekit/version.h"
 
 extern char** environ;
@@ -63,6 +67,7 @@ struct BenchArgs {
   std::string output;
   std::optional<int> effort;
   std::optional<int> threads;
+  std::string reference_dir, reference_script;
 };
 
 bool has_meshes(const fs::path& dir) {
@@ -96,17 +101,21 @@ struct ChildRun {
   double cpu_seconds = 0, wall_seconds = 0, peak_mb = 0;
 };
 
-// Runs this executable with `args`; stdin and stdout go to /dev/null (the child is --quiet
-// anyway), stderr stays ours so its one-line error shows up in the bench output.
-Result<ChildRun> run_child(const std::vector<std::string>& args) {
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return Status(ErrorCode::Internal, "cannot locate the spherekit executable: " + ec.message());
+// Runs program `exe` with `args` and extra environment entries `env` ("NAME=value"); stdin
+// and stdout go to /dev/null (the child is --quiet anyway), stderr stays ours so its
+// one-line error shows up in the bench output.
+Result<ChildRun> run_program(const fs::path& exe, const std::vector<std::string>& args,
+                             const std::vector<std::string>& env = {}) {
   std::vector<std::string> argv_strings = {exe.string()};
   argv_strings.insert(argv_strings.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& s : argv_strings) argv.push_back(s.data());
   argv.push_back(nullptr);
+  std::vector<std::string> env_strings = env;
+  std::vector<char*> envp;
+  for (std::string& s : env_strings) envp.push_back(s.data());
+  for (char** e = environ; *e; ++e) envp.push_back(*e);
+  envp.push_back(nullptr);
 
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -114,7 +123,7 @@ Result<ChildRun> run_child(const std::vector<std::string>& args) {
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   Stopwatch wall;
   pid_t pid = 0;
-  const int err = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+  const int err = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   if (err != 0) return Status(ErrorCode::Internal, std::string("cannot start child process: ") + std::strerror(err));
 
@@ -143,6 +152,67 @@ Result<ChildRun> run_child(const std::vector<std::string>& args) {
   else if (WIFSIGNALED(status))
     run.exit_code = 128 + WTERMSIG(status);
   return run;
+}
+
+// Runs this executable with `args`.
+Result<ChildRun> run_child(const std::vector<std::string>& args) {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return Status(ErrorCode::Internal, "cannot locate the spherekit executable: " + ec.message());
+  return run_program(exe, args);
+}
+
+// The reference implementation measured in the same run (--reference-dir): Praun & Hoppe's
+// SphereParam built by shared/anchors/mpl/build_mpl.sh into that folder, run through the
+// kit's mpl_sphereparam.sh on the same mesh right after ours (alternating, so both see the
+// same machine load), timed the same way, its map measured by our evaluator.
+struct ReferenceKit {
+  fs::path mpl_root, script;
+  int threads = 2;
+};
+
+Result<ReferenceKit> find_reference_kit(const std::string& dir, const std::string& script, int threads) {
+  std::error_code ec;
+  ReferenceKit kit;
+  kit.mpl_root = fs::absolute(dir, ec);
+  if (!fs::is_regular_file(kit.mpl_root / "bin" / "unix" / "SphereParam", ec))
+    return Status(ErrorCode::IoError, dir + ": no bin/unix/SphereParam (build it with shared/anchors/mpl/build_mpl.sh)");
+  if (!script.empty()) {
+    kit.script = script;
+  } else if (auto meshes = find_shared_meshes()) {
+    kit.script = meshes->parent_path() / "anchors" / "mpl" / "mpl_sphereparam.sh";
+  }
+  if (kit.script.empty() || !fs::is_regular_file(kit.script, ec))
+    return Status(ErrorCode::IoError, "cannot find mpl_sphereparam.sh (give --reference-script)");
+  kit.threads = threads > 0 ? threads : 2;
+  return kit;
+}
+
+struct MeasuredReference {
+  ChildRun run;
+  double efficiency = 0, linf = 0;
+  int flipped = -1;
+};
+
+Result<MeasuredReference> run_reference(const ReferenceKit& kit, const std::string& mesh, const std::string& sphere) {
+  MeasuredReference m;
+  SPHEREKIT_ASSIGN_OR_RETURN(m.run, run_program("/bin/bash", {kit.script.string(), mesh, sphere},
+                                                  {"MPL_ROOT=" + kit.mpl_root.string(),
+                                                   "OMP_NUM_THREADS=" + std::to_string(kit.threads)}));
+  if (m.run.exit_code != 0) return m;
+  auto surface = formats::read_mesh(mesh);
+  if (!surface.ok()) return with_file(surface.status(), mesh);
+  formats::ReadOptions lenient;
+  lenient.polygons = formats::PolygonPolicy::Triangulate;
+  auto map = formats::read_mesh(sphere, lenient);
+  if (!map.ok()) return with_file(map.status(), sphere);
+  if (map->V.rows() != surface->V.rows())
+    return Status(ErrorCode::InvalidInput, sphere + ": the reference's map has another vertex count");
+  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics e, evaluate_sphere_map(surface.value(), map->V));
+  m.efficiency = e.efficiency;
+  m.linf = e.linf;
+  m.flipped = e.flipped;
+  return m;
 }
 
 std::string ratio(double ours, double ref) { return ref > 0 ? format_text("%.2f", ours / ref) : std::string("-"); }
@@ -190,7 +260,15 @@ int run_bench(const BenchArgs& a) {
       source = "built-in samples";
     }
   }
-  std::printf("spherekit %s bench: %zu meshes from %s\n", kVersion, meshes.size(), source.c_str());
+  std::optional<ReferenceKit> kit;
+  if (!a.reference_dir.empty()) {
+    auto k = find_reference_kit(a.reference_dir, a.reference_script, a.threads.value_or(0));
+    if (!k.ok()) return print_error(k.status());
+    kit = k.value();
+  }
+  std::printf("spherekit %s bench: %zu meshes from %s; reference: %s\n", kVersion, meshes.size(), source.c_str(),
+              kit ? ("measured in this run (" + kit->mpl_root.string() + ")").c_str()
+                  : "figures recorded in EVALUATION.md (another machine)");
 
   Table table({"mesh", "V", "F", "eff", "ref eff", "d eff", "flips", "CPU s", "ref CPU", "CPU ratio", "wall s",
                "peak MB", "ref MB", "MB ratio", "status"});
@@ -212,6 +290,20 @@ int run_bench(const BenchArgs& a) {
     if (cancel_requested()) return print_error(cancelled_status());
     const ChildRun& c = child.value();
     const Reference* ref = find_reference(mesh);
+    Reference measured{};
+    if (kit) {
+      // Measured side by side: replaces the recorded figures for this mesh.
+      auto r = run_reference(*kit, mesh, (work / (std::to_string(i) + ".reference.sphere.obj")).string());
+      if (!r.ok()) return print_error(r.status());
+      if (cancel_requested()) return print_error(cancelled_status());
+      ref = nullptr;
+      if (r->run.exit_code == 0) {
+        measured = Reference{"", r->efficiency, r->run.cpu_seconds, r->run.peak_mb};
+        ref = &measured;
+      } else {
+        std::fprintf(stderr, "[bench] the reference failed on %s (exit %d)\n", mesh.c_str(), r->run.exit_code);
+      }
+    }
     Json row{{"mesh", mesh}, {"exit_code", c.exit_code}, {"cpu_seconds", c.cpu_seconds},
              {"wall_seconds", c.wall_seconds}, {"peak_mb", c.peak_mb}};
     cpu_total += c.cpu_seconds;
@@ -305,18 +397,25 @@ void register_bench(CLI::App& app) {
       app, "bench", "Time, memory and efficiency of param per mesh vs. the reference",
       "Benchmark `param`: run it on each mesh in a child process (so CPU time and peak memory are\n"
       "per mesh) and print a table of vertices, faces, efficiency, flipped faces, CPU and wall\n"
-      "seconds and peak MB, with the reference implementation's figures (EVALUATION.md §4) and\n"
-      "the ratios ours/reference. Default meshes: the dev meshes (knight ... igea.ply) found in\n"
+      "seconds and peak MB, with the reference implementation's figures and the ratios\n"
+      "ours/reference: measured in the same run with --reference-dir (alternating ours and its\n"
+      "runs mesh by mesh), else the figures recorded in EVALUATION.md §4 on another machine. Default meshes: the dev meshes (knight ... igea.ply) found in\n"
       "--meshes-dir, else in $SPHEREKIT_SHARED_DIR/meshes or a shared/meshes folder above the\n"
       "working directory or the executable; else the built-in samples.",
       "  spherekit bench -o bench.json\n"
       "  spherekit bench --meshes-dir ../shared/meshes --effort 2 --threads 2 -o bench.json\n"
-      "  spherekit bench spot.obj gargoyle.obj");
+      "  spherekit bench spot.obj gargoyle.obj\n"
+      "  spherekit bench --reference-dir $HOME/mpl --threads 1 -o bench.json");
   cmd->add_option("MESH", args->meshes, "meshes to run (default: the dev meshes)");
   cmd->add_option("--meshes-dir", args->meshes_dir, "folder holding the dev meshes (knight.obj ... igea.ply)");
   cmd->add_option("--effort", args->effort, "passed to param (default: param's)")->check(CLI::Range(0, 5));
   cmd->add_option("--threads", args->threads, "passed to param (default: param's)")->check(CLI::NonNegativeNumber);
   cmd->add_option("-o,--output", args->output, "write all rows and totals as JSON here");
+  cmd->add_option("--reference-dir", args->reference_dir,
+                  "MPL folder built by shared/anchors/mpl/build_mpl.sh: run the reference on each mesh right after "
+                  "ours and compare with what it measures here, not with recorded figures");
+  cmd->add_option("--reference-script", args->reference_script,
+                  "mpl_sphereparam.sh (default: shared/anchors/mpl/ beside the dev meshes)");
   cmd->callback([args] { set_exit_code(run_bench(*args)); });
 }
 

@@ -223,6 +223,21 @@ class Simplifier {
     if (!keep_b && path_allows(b, a)) heap_.push({cost(b, a), b, a, stamp_[b], stamp_[a]});
   }
 
+  // Drops the entries made stale by later collapses (memoryless quadrics re-push a 2-ring per
+  // collapse, so most entries go stale): peak memory stays proportional to the live edges.
+  // The pop order is a total order on (cost, vt, vs), so the collapses are unchanged.
+  void compact_heap() {
+    std::vector<HeapEntry> live;
+    while (!heap_.empty()) {
+      const HeapEntry& e = heap_.top();
+      if (vertex_alive_[e.vt] && vertex_alive_[e.vs] && e.stamp_t == stamp_[e.vt] && e.stamp_s == stamp_[e.vs])
+        live.push_back(e);
+      heap_.pop();
+    }
+    heap_ = decltype(heap_)(HeapGreater(), std::move(live));
+    compact_at_ = std::max<size_t>(65536, 2 * heap_.size());
+  }
+
   void rebuild_heap() {
     heap_ = decltype(heap_)();
     for (size_t f = 0; f < faces_.size(); ++f) {
@@ -352,6 +367,7 @@ class Simplifier {
     } else {
       for (int w : ns_) push_edge(vs, w);
     }
+    if (heap_.size() > compact_at_) compact_heap();
     return true;
   }
 
@@ -370,6 +386,7 @@ class Simplifier {
   std::vector<int> nt_, ns_;
   std::vector<std::vector<int>> path_nbr_;  // per vertex: its neighbours along path edges
   std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;
+  size_t compact_at_ = 65536;  // heap size that triggers compact_heap
 };
 
 }  // namespace

@@ -1,16 +1,41 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages SphereKit builds and tests with. Idempotent: it asks apt
-# only for what is missing, and refreshes the package lists only then. Non-interactive.
+# Installs the Debian 12 packages SphereKit builds, runs and tests with. Idempotent: it asks
+# apt only for what is missing, and refreshes the package lists only then. Non-interactive.
+#   bash scripts/install_deps.sh          build + the main job (scripts/run.sh)
+#   bash scripts/install_deps.sh --test   also what the tests need (scripts/test.sh)
 set -euo pipefail
+
+with_tests=0
+for arg in "$@"; do
+  case "$arg" in
+    --test) with_tests=1 ;;
+    -h|--help) sed -n '2,5p' "$0"; exit 0 ;;
+    *) echo "install_deps: unknown argument '$arg' (only --test)" >&2; exit 2 ;;
+  esac
+done
 
 # OpenMesh is not used: libparam has its own half-edge code (Debian's libopenmesh-dev also
 # pulls in ~190 MB of OpenSceneGraph/GDAL dependencies).
 packages=(
   cmake g++ ninja-build pkg-config
-  libeigen3-dev nlohmann-json3-dev libcli11-dev catch2
-  libosd-dev libopenexr-dev libtinygltf-dev libdraco-dev libstb-dev libtbb-dev
-  python3-numpy python3-scipy
+  libeigen3-dev nlohmann-json3-dev libcli11-dev catch2 zlib1g-dev
+  libosd-dev libopenexr-dev libtinygltf-dev libdraco-dev libstb-dev
+  # the Python module (python/): pybind11 and the interpreter's headers; numpy arrays in and out
+  python3-dev python3-pybind11 python3-numpy python3-scipy
 )
+# The results page's 3-D viewer (scripts/setup_viewer.sh bundles three.js from npm) needs node
+# and npm: Debian's, unless a node with its npm is on PATH already (e.g. NodeSource's nodejs,
+# which bundles npm and conflicts with Debian's npm package).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
+# npm fetches over https: Debian's node uses the system's certificate store.
+packages+=(ca-certificates)
+if [[ "$with_tests" == 1 ]]; then
+  # pytest for python/tests; Chromium for the results page's browser test; dpkg-dev and file
+  # for the Debian package's dependency scan (CPack runs dpkg-shlibdeps on every ELF file).
+  packages+=(python3-pytest chromium dpkg-dev file)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

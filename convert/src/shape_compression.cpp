@@ -1,17 +1,14 @@
 // The PCA-versus-Draco compression experiment (see shape_compression.h for what is counted).
 #include "spherekit/convert/shape_compression.h"
 
+#include <zlib.h>
+
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
+#include <vector>
 
 #include "spherekit/convert/gltf_draco.h"
-
-// stb_image_write's deflate encoder. libstb.so exports it (it is what its PNG writer uses), but
-// stb_image_write.h declares it only inside its implementation section, hence the declaration
-// here (C linkage, as the library is C). The buffer is malloc'ed by stb and freed here.
-extern "C" unsigned char* stbi_zlib_compress(unsigned char* data, int data_len, int* out_len, int quality);
 
 namespace spherekit::convert {
 namespace {
@@ -55,13 +52,15 @@ Stored store(const double* x, std::size_t n, int bits) {
   return s;
 }
 
+// zlib at its best level: what a plain entropy coder gets from the payload. Should zlib fail
+// (it cannot, short of memory), the payload counts uncompressed.
 std::size_t deflated_size(const std::string& bytes) {
   if (bytes.empty()) return 0;
-  int len = 0;
-  unsigned char* z = stbi_zlib_compress(reinterpret_cast<unsigned char*>(const_cast<char*>(bytes.data())),
-                                        static_cast<int>(bytes.size()), &len, 8);
-  if (!z) return bytes.size();
-  std::free(z);
+  uLongf len = compressBound(static_cast<uLong>(bytes.size()));
+  std::vector<Bytef> z(len);
+  if (compress2(z.data(), &len, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uLong>(bytes.size()),
+                Z_BEST_COMPRESSION) != Z_OK)
+    return bytes.size();
   return static_cast<std::size_t>(len);
 }
 

@@ -79,8 +79,7 @@ TEST_CASE("shared meshes: eval agrees with evalsphere.py on small shared meshes"
       break;
     }
   if (!fs::exists(evalsphere) || python.empty()) {
-    WARN("SKIPPED: shared/tools/evalsphere.py or python3-numpy missing");
-    return;
+    SPHEREKIT_SKIP("shared/tools/evalsphere.py or python3-numpy missing");
   }
   const std::string dir = spherekit::test::temp_dir("cli_shared_eval");
   // knight: closed; woody: one hole (measured over its real faces).

@@ -186,6 +186,8 @@ Interrupted interrupt_first_running(const std::vector<Attempt>& attempts, const 
     WARN("attempt " << i << " finished before SIGINT arrived (exit 0): nothing was interrupted");
     if (i + 1 < attempts.size()) reset();
   }
+  // Not a return: the caller's checks of the finished run still apply.
+  spherekit::test::note_skip("the cancellation checks: every job finished before SIGINT arrived");
   WARN("SKIPPED the cancellation checks: every job finished before SIGINT arrived");
   return r;
 }

@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include "test_skip.h"
+
 namespace spherekit::test {
 
 /// Absolute path of the shared/ folder beside the checkout (SPHEREKIT_SHARED_DIR overrides),
@@ -21,7 +23,6 @@ std::string temp_dir(const std::string& name);
 #define SPHEREKIT_REQUIRE_SHARED_MESHES(var)                                             \
   auto var##_opt = ::spherekit::test::shared_meshes_dir();                                \
   if (!var##_opt) {                                                                       \
-    WARN("SKIPPED: ../shared/meshes is absent (set SPHEREKIT_SHARED_DIR); test skipped"); \
-    return;                                                                               \
+    SPHEREKIT_SKIP("../shared/meshes is absent (set SPHEREKIT_SHARED_DIR)");              \
   }                                                                                       \
   const std::string var = *var##_opt

@@ -157,8 +157,7 @@ void check_blender_matches(const BlenderCageResult& b, const std::string& what) 
 TEST_CASE("Blender reproduces the displaced cage of a generated mesh (scalar and vector)", "[convert][cage][blender]") {
   const BlenderInfo& blender = blender_info();
   if (blender.exe.empty()) {
-    WARN("SKIPPED: Blender is not available: " << blender.why);
-    return;
+    SPHEREKIT_SKIP("Blender is not available: " << blender.why);
   }
   const std::string dir = test::temp_dir("blender_cage_generated");
   const TriMesh blob = test::random_blob(4, 5);
@@ -176,8 +175,7 @@ TEST_CASE("Blender reproduces the displaced cage of spot (scalar and vector)", "
   SPHEREKIT_REQUIRE_SHARED_MESHES(meshes);
   const BlenderInfo& blender = blender_info();
   if (blender.exe.empty()) {
-    WARN("SKIPPED: Blender is not available: " << blender.why);
-    return;
+    SPHEREKIT_SKIP("Blender is not available: " << blender.why);
   }
   const std::string dir = test::temp_dir("blender_cage_spot");
   const std::string mesh = meshes + "/spot.obj", sphere = dir + "/spot.sphere.obj";

@@ -13,7 +13,7 @@
 // coefficient matrix are quantized uniformly on their own [min, max] (2^b - 1 steps, each
 // array's min and max kept as two float32), packed into whole bytes (b <= 8: 1 byte, <= 16:
 // 2, else 4 bytes a value); `bytes` counts that payload, `bytes_deflated` the same bytes after
-// zlib deflate (stb's encoder, level 8) as a plain entropy coder would give. Bytes per shape
+// zlib deflate (zlib, best level) as a plain entropy coder would give. Bytes per shape
 // divide the whole model by n, so the mean and components are shared by the collection: PCA
 // pays off once the collection is large relative to the components kept.
 // Draco at b position bits: edgebreaker encoding of positions and faces (compression level

@@ -3,30 +3,49 @@
 #   bash scripts/test.sh
 #   bash scripts/test.sh -R cli      (extra arguments go to the normal build's ctest)
 # Two builds are tested:
-#   build/       Release: every test, including the slow runs over ../shared/meshes;
+#   build/       Release: every test, including the slow runs over ../shared/meshes, the install
+#                and package tests (ctest -L install) and the Python module's pytest tests;
 #   build-asan/  AddressSanitizer + UndefinedBehaviorSanitizer (any finding fails the test):
 #                every test except the slow whole-corpus runs, which the normal build covers.
 # SPHEREKIT_SKIP_SANITIZE=1 skips the sanitizer build (a quicker local run).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
-bash "$root/scripts/install_deps.sh"
+bash "$root/scripts/install_deps.sh" --test
 bash "$root/scripts/build.sh"
-# The results page's viewer and its browser test (npm packages, Debian's Chromium): optional,
-# that test skips with setup_viewer.sh's message when they cannot be installed.
-bash "$root/scripts/setup_viewer.sh" --browser --install-chromium >/dev/null || true
+# The results page's viewer and its browser test (npm packages, Debian's Chromium). When they
+# cannot be installed that test is reported as skipped, with setup_viewer.sh's message.
+if ! bash "$root/scripts/setup_viewer.sh" --browser --install-chromium >/dev/null; then
+  echo "test.sh: WARNING: setup_viewer.sh failed (message above): the results page's browser test will be skipped" >&2
+fi
 # Debian's Blender for the cage + displacement test (issue 22; ~50 s, 166 MB): optional, that
-# test skips with a message when it cannot be installed.
+# test is reported as skipped with a message when it cannot be installed.
 bash "$root/scripts/setup_blender.sh" >/dev/null || true
+
+# Tests that could not run here print "SPHEREKIT-SKIP: reason" (tests/common/test_skip.h, and
+# the shell tests); ctest reports them as skipped. List them with their reasons.
+print_skips() {  # print_skips BUILD_DIR LABEL
+  local skips
+  skips="$(awk '/^[0-9]+\/[0-9]+ Test: /{sub(/^[0-9]+\/[0-9]+ Test: /, ""); name=$0}
+                /^SPHEREKIT-SKIP: /{sub(/^SPHEREKIT-SKIP: /, ""); print "  " name ": " $0}' \
+             "$1/Testing/Temporary/LastTest.log" 2>/dev/null | sort -u)"
+  if [[ -n "$skips" ]]; then
+    echo "test.sh: $2: $(grep -c . <<<"$skips") skipped (not passed):"
+    echo "$skips"
+  else
+    echo "test.sh: $2: no test skipped"
+  fi
+}
 
 log="$(mktemp)"
 asan_log=""
+pytest_log=""
 # A one-node Slurm cluster for the Slurm back end's test (issue 23; scale: "Slurm back end ..."):
 # slurm-wlm from apt, munged/slurmctld/slurmd as background processes stopped by PID on exit.
 # Where it cannot be installed or started, that test skips with a message.
 slurm_started=0
 cleanup() {
-  rm -f "$log" ${asan_log:+"$asan_log"}
+  rm -f "$log" ${asan_log:+"$asan_log"} ${pytest_log:+"$pytest_log"}
   if [[ "$slurm_started" == 1 ]]; then bash "$root/scripts/slurm_local.sh" stop || true; fi
 }
 trap cleanup EXIT
@@ -45,6 +64,19 @@ if [[ "$slurm_started" == 1 ]]; then
   bash "$root/scripts/slurm_local.sh" stop || true
   slurm_started=0
 fi
+skips="$(print_skips "$root/build" "Release build")"
+
+# The Python module (python/tests), built in build/python; compared with build's program.
+# A run that collects no test (pytest exit 5) fails like any other failure.
+echo "test.sh: Python module tests (pytest)"
+pytest_log="$(mktemp)"
+pytest_status=0
+python=python3
+if [[ -x /usr/bin/python3 ]]; then python=/usr/bin/python3; fi  # Debian's, with python3-pytest and numpy
+PYTHONPATH="$root/build/python" SPHEREKIT_EXE="$root/build/tools/cli/spherekit" PYTHONDONTWRITEBYTECODE=1 \
+  "$python" -m pytest -q -rs -p no:cacheprovider "$root/python/tests" 2>&1 | tee "$pytest_log" || pytest_status=$?
+pytest_summary="pytest: $(grep -E '(passed|failed|skipped|error|no tests ran)' "$pytest_log" | tail -1 || true) (exit $pytest_status)"
+if [[ "$pytest_status" != 0 ]]; then status="$pytest_status"; fi
 
 if [[ "${SPHEREKIT_SKIP_SANITIZE:-0}" != "1" ]]; then
   echo "test.sh: sanitizer build (ASan + UBSan)"
@@ -66,10 +98,13 @@ if [[ "${SPHEREKIT_SKIP_SANITIZE:-0}" != "1" ]]; then
       -E "shared meshes|without meshes|determinism:|interrupt:|transfer, morph and pca|Khronos validator|one layout for every member|effort 0 and effort 5|deterministic, also across|same bits for any thread count|dense feature set \\(64 features\\)|Blender reproduces|Slurm back end|kill -9 at 20 random moments" \
       2>&1 | tee "$asan_log" || asan_status=$?
   asan_summary="$(grep -E '^[0-9]+% tests passed' "$asan_log" | tail -1 || true)"
+  print_skips "$root/build-asan" "sanitizer build"
   echo "sanitizer build: ${asan_summary:-ctest printed no summary}"
   if [[ "$asan_status" != 0 ]]; then status="$asan_status"; fi
 fi
 
-# Repeat the normal build's verdict as the last line, so it is the first thing one sees.
+# Repeat the normal build's verdict (and what was skipped) last, so it is the first thing one sees.
+echo "$skips"
+echo "$pytest_summary"
 echo "${summary:-ctest printed no summary}"
 exit "$status"

@@ -10,7 +10,8 @@
 #   install_test.sh deb BUILD_DIR SOURCE_DIR VERSION
 #       cpack the Debian packages; check that every Depends of spherekit_VERSION_amd64.deb is
 #       installed or installable here (dpkg-query / apt-cache policy); extract it into a scratch
-#       root (dpkg -x) and run its spherekit (`run` on two small samples) from there. A real `apt-get install ./spherekit_*.deb` on a clean Debian 12 root is
+#       root (dpkg -x) and run its spherekit (`run` on two small samples) and Python module from
+#       there. A real `apt-get install ./spherekit_*.deb` on a clean Debian 12 root is
 #       scripts/check_minimal_root.sh (needs root and a few minutes; not run by ctest).
 # Scratch files go to BUILD_DIR/tests/install-MODE (replaced on each run). Exit 0 pass, 1 fail,
 # 77 skipped (printed reason).
@@ -113,6 +114,7 @@ deb)
   echo "install_test: all ${#deps[@]} dependencies are installed or installable"
   dpkg-deb -c "$deb" >"$work/contents.txt"
   grep -q '\./usr/bin/spherekit$' "$work/contents.txt" || fail "the package has no /usr/bin/spherekit"
+  grep -q 'usr/lib/python3/dist-packages/spherekit\..*\.so$' "$work/contents.txt" || fail "the package has no Python module"
   dpkg-deb -c "$dev" >"$work/contents-dev.txt"
   grep -q "cmake/SphereKit/SphereKitConfig.cmake$" "$work/contents-dev.txt" || fail "spherekit-dev has no SphereKitConfig.cmake"
   grep -q libeigen3-dev <<<"$(dpkg-deb -f "$dev" Depends)" || fail "spherekit-dev does not depend on libeigen3-dev"
@@ -128,6 +130,14 @@ deb)
     [[ -s "$work/out/$f" ]] || fail "packaged spherekit run wrote no $f"
   done
   echo "install_test: the packaged spherekit ran the main job on two samples ($work/out)"
+  PYTHONPATH="$rootfs/usr/lib/python3/dist-packages" /usr/bin/python3 -c "
+import spherekit, sys
+assert spherekit.__file__.startswith('$rootfs'), spherekit.__file__
+m = spherekit.read_mesh('$work/samples/sample_a.obj')
+r = spherekit.param(m, effort=0)
+assert r.flipped_faces == 0 and spherekit.__version__ == '$version'
+print('install_test: the packaged Python module', spherekit.__version__, 'mapped', m.vertices, 'vertices, 0 flips')
+" || fail "the packaged Python module"
   ;;
 *) echo "install_test: unknown mode '$mode'" >&2; exit 2 ;;
 esac

@@ -54,9 +54,10 @@ cleanup() {
 trap cleanup EXIT
 mount_into() {  # mount_into ROOT: what chroot needs (processes, devices, shared memory for Chromium)
   local r="$1" d
-  for d in proc sys dev dev/pts; do
+  for d in proc sys dev; do
     mkdir -p "$r/$d"
-    mount --bind "/$d" "$r/$d"
+    mount --rbind "/$d" "$r/$d"  # recursive: /dev/pts and /dev/shm (Chromium) too
+    mount --make-rslave "$r/$d"
     mounted+=("$r/$d")
   done
   cp /etc/resolv.conf "$r/etc/resolv.conf"

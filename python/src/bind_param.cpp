@@ -59,11 +59,22 @@ RowMat3d from_points(const std::vector<Eigen::Vector3d>& p) {
   return m;
 }
 
+// The measures every map result has (SphereParamResult, ConstrainedParamResult); S is a view.
+template <class Result>
+void bind_map_measures(pyb::class_<Result>& c) {
+  c.def_readonly("map", &Result::map)
+      .def_property_readonly("S", [](Result& r) -> RowMat3d& { return r.map.S; }, pyb::return_value_policy::reference_internal)
+      .def_readonly("flipped_faces", &Result::flipped_faces)
+      .def_readonly("efficiency", &Result::efficiency)
+      .def_readonly("l2_stretch", &Result::l2_stretch)
+      .def_readonly("linf_stretch", &Result::linf_stretch)
+      .def_readonly("winding", &Result::winding)
+      .def_readonly("holes_filled", &Result::holes_filled);
+}
+
 }  // namespace
 
 void bind_param(pyb::module_& m) {
-  const auto ref = pyb::return_value_policy::reference_internal;
-
   m.def("check", [](const Mesh& mesh) { return check_dict(check_mesh(mesh.mesh)); }, pyb::arg("mesh"),
         "Structural report of a mesh as a dict (the fields of `spherekit check --json`, plus 'accepted' and\n"
         "'problem': whether param accepts it and, if not, the command line's message).");
@@ -87,16 +98,9 @@ void bind_param(pyb::module_& m) {
       .def_readonly("S", &SphereMap::S, "#V x 3 unit vectors, in the mesh's vertex order")
       .def_property_readonly("provenance", [](const SphereMap& s) { return provenance_dict(s.provenance); });
 
-  pyb::class_<SphereParamResult>(m, "SphereParamResult")
-      .def_readonly("map", &SphereParamResult::map)
-      .def_property_readonly("S", [](SphereParamResult& r) -> RowMat3d& { return r.map.S; }, ref)
-      .def_readonly("flipped_faces", &SphereParamResult::flipped_faces)
-      .def_readonly("efficiency", &SphereParamResult::efficiency)
-      .def_readonly("l2_stretch", &SphereParamResult::l2_stretch)
-      .def_readonly("linf_stretch", &SphereParamResult::linf_stretch)
-      .def_readonly("winding", &SphereParamResult::winding)
-      .def_readonly("holes_filled", &SphereParamResult::holes_filled)
-      .def_readonly("base_vertices", &SphereParamResult::base_vertices)
+  auto sphere_result = pyb::class_<SphereParamResult>(m, "SphereParamResult");
+  bind_map_measures(sphere_result);
+  sphere_result.def_readonly("base_vertices", &SphereParamResult::base_vertices)
       .def_readonly("optimization_passes", &SphereParamResult::optimization_passes)
       .def_property_readonly("times", [](const SphereParamResult& r) {
         return pyb::dict(pyb::arg("check") = r.times.check, pyb::arg("simplify") = r.times.simplify,
@@ -125,16 +129,9 @@ void bind_param(pyb::module_& m) {
       .def_readonly("steiner_vertices", &FeatureNetworkReport::steiner_vertices)
       .def_readonly("auxiliary_features", &FeatureNetworkReport::auxiliary_features);
 
-  pyb::class_<ConstrainedParamResult>(m, "ConstrainedParamResult")
-      .def_readonly("map", &ConstrainedParamResult::map)
-      .def_property_readonly("S", [](ConstrainedParamResult& r) -> RowMat3d& { return r.map.S; }, ref)
-      .def_readonly("flipped_faces", &ConstrainedParamResult::flipped_faces)
-      .def_readonly("efficiency", &ConstrainedParamResult::efficiency)
-      .def_readonly("l2_stretch", &ConstrainedParamResult::l2_stretch)
-      .def_readonly("linf_stretch", &ConstrainedParamResult::linf_stretch)
-      .def_readonly("winding", &ConstrainedParamResult::winding)
-      .def_readonly("max_feature_angle", &ConstrainedParamResult::max_feature_angle)
-      .def_readonly("holes_filled", &ConstrainedParamResult::holes_filled)
+  auto constrained_result = pyb::class_<ConstrainedParamResult>(m, "ConstrainedParamResult");
+  bind_map_measures(constrained_result);
+  constrained_result.def_readonly("max_feature_angle", &ConstrainedParamResult::max_feature_angle)
       .def_readonly("network", &ConstrainedParamResult::network);
 
   m.def(

@@ -47,13 +47,13 @@ def test_consistent_writes_the_cli_bytes(exe, samples, tmp_path):
     names = ["sample_a", "sample_b"]  # two members keep it short; the six steps all run
     col = tmp_path / "col"
     subprocess.run([exe, "consistent", "-o", str(col), *[str(samples / f"{n}.obj") for n in names],
-                    "--remesh-size", "33", "--quiet"], check=True)
+                    "--remesh-size", "33", "--effort", "1", "--quiet"], check=True)
 
     meshes = [sk.read_mesh(str(samples / f"{n}.obj")) for n in names]
     landmarks = [sk.read_landmarks(str(samples / f"{n}.lm.txt"), m.vertices) for n, m in zip(names, meshes)]
     order = [name for name, _ in landmarks[0]]
     features = [[dict(lms)[name] for name in order] for lms in landmarks]
-    result = sk.consistent(meshes, features, remesh_size=33)
+    result = sk.consistent(meshes, features, remesh_size=33, effort=1)
     assert len(result.maps) == len(names)
     for name, mesh, m in zip(names, meshes, result.maps):
         assert m.flipped_faces == 0 and m.max_feature_angle < 1e-9

@@ -90,6 +90,13 @@ timed "1. debootstrap --variant=minbase bookworm" \
 rm -f "$root/etc/apt/sources.list"
 cp /etc/apt/sources.list.d/*.sources "$root/etc/apt/sources.list.d/" 2>/dev/null \
   || echo "deb $mirror bookworm main" >"$root/etc/apt/sources.list"
+# Local certificate authorities the host trusts (a proxy's, e.g.): without them npm's https
+# requests fail in the roots on such networks (SELF_SIGNED_CERT_IN_CHAIN). The ca-certificates
+# package, which install_deps.sh installs, takes them in.
+if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null; then
+  mkdir -p "$root/usr/local/share/ca-certificates"
+  cp /usr/local/share/ca-certificates/*.crt "$root/usr/local/share/ca-certificates/"
+fi
 cp -a "$root" "$pristine"
 
 timed "2. fresh clone of $(git -C "$repo" rev-parse --short HEAD) into the root" \

@@ -34,7 +34,9 @@ chromium="${CHROMIUM:-/usr/bin/chromium}"
 # Pinned, so that every results folder gets the viewer the page was tested with.
 three_version=0.187.0
 packages=(three@$three_version esbuild@0.28.2)
-if [[ "$browser" == 1 ]]; then packages+=(playwright-core@1.65.1); fi
+# playwright-core 1.61.1: the last release that runs on Debian 12's Node.js 18 (1.62 and later
+# refuse it: "Playwright requires Node.js 20 or higher"); it drives Debian's Chromium 156.
+if [[ "$browser" == 1 ]]; then packages+=(playwright-core@1.61.1); fi
 
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
   echo "setup_viewer: node and npm are not installed (e.g. apt-get install nodejs npm)" >&2

@@ -48,8 +48,7 @@ TEST_CASE("Slurm back end: a 12-member collection through job arrays equals the 
           "[cli][scale][slurm][slow]") {
   std::string why;
   if (!slurm_available(&why)) {
-    WARN("SKIPPED: no Slurm cluster: " << why);
-    return;
+    SPHEREKIT_SKIP("no Slurm cluster: " << why);
   }
   const std::string dir = spherekit::test::temp_dir("scale_slurm");
   const std::string s = dir + "/s";

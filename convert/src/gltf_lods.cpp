@@ -11,15 +11,17 @@
 #include <utility>
 
 #include "gltf_document.h"
+#include "spherekit/convert/adaptive_lods.h"
 #include "spherekit/formats/atomic_file.h"
 
 namespace spherekit::convert {
 namespace {
 
 // mesh.extras.spherekit of one level.
-tinygltf::Value level_extras(int level, int image_size, int texture_size, const QuantizationChoice& q) {
+tinygltf::Value level_extras(int level, int image_size, int texture_size, const QuantizationChoice& q, LodMode mode) {
   tinygltf::Value::Object o;
   o["lod"] = detail::json_int(level);
+  o["lod_mode"] = detail::json_string(mode == LodMode::Adaptive ? "adaptive" : "uniform");
   o["geometry_image_size"] = detail::json_int(image_size);
   o["texture_size"] = detail::json_int(texture_size);
   o["quantization"] = detail::quantization_json(q, true, true);
@@ -84,9 +86,39 @@ Result<std::vector<GeometryImage>> lod_geometry_images(const TriMesh& mesh, cons
   return out;
 }
 
+namespace {
+
+// The levels of `adaptive_lod_meshes` for one member, holes dropped if asked.
+std::vector<GltfMesh> adaptive_member_levels(std::vector<std::vector<GltfMesh>>& all, std::size_t member,
+                                             const GeometryImage& finest, bool drop_hole_faces) {
+  std::vector<GltfMesh> meshes;
+  for (auto& level : all) {
+    GltfMesh mesh = std::move(level[member]);
+    // The rule of geometry_image_hole_faces on the level's corners (their texels in the finest
+    // image): a face with two or three hole corners spans a hole.
+    if (drop_hole_faces) mesh = gltf_mesh_without_faces(mesh, gltf_mesh_hole_faces(mesh, finest));
+    meshes.push_back(std::move(mesh));
+  }
+  return meshes;
+}
+
+Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
+                                   const GltfLodOptions& options, const ProgressFn& progress);
+
+}  // namespace
+
 Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOptions& options,
                                  const ProgressFn& progress) {
   SPHEREKIT_RETURN_IF_ERROR(check_lod_options(image.size, options.levels, options));
+  if (options.mode == LodMode::Adaptive) {
+    AdaptiveLodOptions a;
+    a.levels = options.levels;
+    a.lod0_vertex_fraction = options.lod0_vertex_fraction;
+    SPHEREKIT_ASSIGN_OR_RETURN(auto all, adaptive_lod_meshes({image}, a, progress));
+    return build_from_meshes(adaptive_member_levels(all, 0, image, options.drop_hole_faces),
+                             std::vector<int>(static_cast<std::size_t>(options.levels), image.size), image.size,
+                             options, progress);
+  }
   std::vector<GeometryImage> levels{image};
   for (int k = 1; k < options.levels; ++k) {
     SPHEREKIT_ASSIGN_OR_RETURN(GeometryImage sub, subsample_geometry_image(image, level_size(image.size, k)));
@@ -101,23 +133,73 @@ Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
   const int n = level_images[0].size;
   const int levels = static_cast<int>(level_images.size());
   SPHEREKIT_RETURN_IF_ERROR(check_lod_options(n, levels, options));
+  if (options.mode == LodMode::Adaptive) {
+    GltfLodOptions o = options;
+    o.levels = levels;
+    return build_gltf_lods(level_images[0], o, progress);
+  }
   for (int k = 1; k < levels; ++k)
     if (level_images[static_cast<std::size_t>(k)].size != level_size(n, k))
       return Status(ErrorCode::InvalidArgument, "level " + std::to_string(k) + " of detail is not " +
                                                     std::to_string(level_size(n, k)) + " texels wide");
-
-  // Every level's primitive first: the shared quantization grid must hold all of them (fitted
-  // levels can stray a little outside the finest level's bounding box).
-  GltfLods out;
   std::vector<GltfMesh> meshes;
-  meshes.reserve(level_images.size());
+  std::vector<int> sizes;
   for (int k = 0; k < levels; ++k) {
     SPHEREKIT_ASSIGN_OR_RETURN(GltfMesh mesh, gltf_mesh_from_geometry_image(level_images[static_cast<std::size_t>(k)], n));
     // Before encoding the faces are geometry_image_mesh's, in its order.
     if (options.drop_hole_faces)
       mesh = gltf_mesh_without_faces(mesh, geometry_image_hole_faces(level_images[static_cast<std::size_t>(k)]));
     meshes.push_back(std::move(mesh));
+    sizes.push_back(level_images[static_cast<std::size_t>(k)].size);
   }
+  return build_from_meshes(std::move(meshes), sizes, n, options, progress);
+}
+
+Result<std::vector<GltfLods>> build_consistent_gltf_lods(const std::vector<GeometryImage>& members,
+                                                         const std::vector<GltfLodOptions>& options,
+                                                         const ProgressFn& progress) {
+  if (members.empty() || options.size() != members.size())
+    return Status(ErrorCode::InvalidArgument, "consistent levels of detail need one option set per member");
+  const GltfLodOptions& first = options[0];
+  for (const GeometryImage& g : members)
+    SPHEREKIT_RETURN_IF_ERROR(check_lod_options(g.size, first.levels, first));
+  std::vector<GltfLods> out;
+  if (first.mode == LodMode::Uniform) {
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      GltfLodOptions o = options[m];
+      o.mode = LodMode::Uniform;
+      o.levels = first.levels;
+      o.drop_hole_faces = false;
+      SPHEREKIT_ASSIGN_OR_RETURN(GltfLods lods, build_gltf_lods(members[m], o, progress));
+      out.push_back(std::move(lods));
+    }
+    return out;
+  }
+  AdaptiveLodOptions a;
+  a.levels = first.levels;
+  a.lod0_vertex_fraction = first.lod0_vertex_fraction;
+  SPHEREKIT_ASSIGN_OR_RETURN(auto all, adaptive_lod_meshes(members, a, progress));
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    GltfLodOptions o = options[m];
+    o.mode = LodMode::Adaptive;
+    o.levels = first.levels;
+    SPHEREKIT_ASSIGN_OR_RETURN(GltfLods lods,
+                               build_from_meshes(adaptive_member_levels(all, m, members[m], false),
+                                                 std::vector<int>(static_cast<std::size_t>(a.levels), members[m].size),
+                                                 members[m].size, o, progress));
+    out.push_back(std::move(lods));
+  }
+  return out;
+}
+
+namespace {
+
+Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
+                                   const GltfLodOptions& options, const ProgressFn& progress) {
+  const int levels = static_cast<int>(meshes.size());
+  // Every level's primitive first: the shared quantization grid must hold all of them (fitted
+  // levels can stray a little outside the finest level's bounding box).
+  GltfLods out;
   GltfMesh all_points = meshes[0];
   for (int k = 1; k < levels; ++k) {
     const GltfMesh& m = meshes[static_cast<std::size_t>(k)];
@@ -140,13 +222,13 @@ Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
     if (!report_progress(progress, "gltf", k, static_cast<double>(k) / levels))
       return Status(ErrorCode::Cancelled, "cancelled");
     GltfLodLevel level;
-    level.image_size = level_images[static_cast<std::size_t>(k)].size;
-    const GltfMesh& mesh = meshes[static_cast<std::size_t>(k)];
-    SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(mesh, encode));
+    level.image_size = sizes[static_cast<std::size_t>(k)];
+    level.mesh = std::move(meshes[static_cast<std::size_t>(k)]);
+    SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(level.mesh, encode));
 
     detail::GlbBuilder doc;
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, out.quantization));
+                                     level_extras(k, level.image_size, n, out.quantization, options.mode));
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;
@@ -170,7 +252,7 @@ Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
   for (int k = 0; k < levels; ++k) {
     const GltfLodLevel& level = out.levels[static_cast<std::size_t>(k)];
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, out.quantization));
+                                     level_extras(k, level.image_size, n, out.quantization, options.mode));
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;
@@ -196,6 +278,8 @@ Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
   if (!report_progress(progress, "gltf", levels, 1.0)) return Status(ErrorCode::Cancelled, "cancelled");
   return out;
 }
+
+}  // namespace
 
 Result<GltfLodPaths> write_gltf_lods(const std::string& prefix, const GltfLods& lods) {
   GltfLodPaths paths = gltf_lod_paths(prefix, static_cast<int>(lods.levels.size()));

@@ -60,6 +60,31 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     files.push_back(holed_paths->combined);
   }
 
+  // Adaptive levels (adaptive_lods_test): a mesh with holes left open, a collection's levels and
+  // each level's morph-target file.
+  {
+    GltfLodOptions adaptive = test::lod_test_options();
+    adaptive.mode = LodMode::Adaptive;
+    adaptive.drop_hole_faces = true;
+    auto holed = build_gltf_lods(test::holed_lod_images(33, 3).levels, adaptive);
+    REQUIRE(holed.ok());
+    auto holed_paths = write_gltf_lods(dir + "/adaptive_holed", holed.value());
+    REQUIRE(holed_paths.ok());
+    files.insert(files.end(), holed_paths->levels.begin(), holed_paths->levels.end());
+    files.push_back(holed_paths->combined);
+    adaptive.drop_hole_faces = false;
+    auto collection = build_consistent_gltf_lods(
+        {test::blob_geometry_image(33, 3, 7), test::blob_geometry_image(33, 3, 8)}, {adaptive, adaptive});
+    REQUIRE(collection.ok());
+    for (std::size_t m = 0; m < 2; ++m) write("adaptive_member" + std::to_string(m) + ".glb", (*collection)[m].combined_glb);
+    for (std::size_t k = 0; k < (*collection)[0].levels.size(); ++k) {
+      auto morph = build_gltf_morph_targets(
+          std::vector<GltfMesh>{(*collection)[0].levels[k].mesh, (*collection)[1].levels[k].mesh});
+      REQUIRE(morph.ok());
+      write("adaptive_morph_lod" + std::to_string(k) + ".glb", morph->glb);
+    }
+  }
+
   // gltf_morph_test: uncompressed, Draco sequential, from triangle meshes.
   const std::vector<GltfMesh> members = test::collection_test_meshes(17);
   auto plain = build_gltf_morph_targets(members);

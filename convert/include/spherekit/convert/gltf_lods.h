@@ -51,8 +51,20 @@ struct GltfProvenance {
   std::string sphere_map;   ///< path or name of the sphere map
 };
 
+/// How the levels are made.
+enum class LodMode {
+  /// Level k = the geometry image of (N-1)/2^k + 1 texels (given or subsampled).
+  Uniform,
+  /// Level k = the finest image's remesh simplified by quadric edge collapses to a quarter of
+  /// the previous level's vertices (adaptive_lods.h); the coarser images, if given, are unused.
+  Adaptive,
+};
+
 struct GltfLodOptions {
   // Shape-defining
+  LodMode mode = LodMode::Uniform;
+  /// Adaptive: vertices of level 0 as a fraction of the finest remesh's (adaptive_lods.h).
+  double lod0_vertex_fraction = 0.25;
   int levels = 4;  ///< number of levels (>= 1); (N-1)/2^(levels-1) must be >= 2
   QuantizationBudget budget;  ///< how the quantization is chosen (gltf_draco.h)
   /// RMS surface error of level 0 against the original mesh (absolute units; remesh_error().rms
@@ -72,7 +84,10 @@ struct GltfLodOptions {
 
 /// One level of detail.
 struct GltfLodLevel {
-  int image_size = 0;         ///< texels per side of the level's geometry image
+  /// Texels per side of the level's geometry image (Adaptive: the finest image's, which the
+  /// level's texture coordinates index).
+  int image_size = 0;
+  GltfMesh mesh;              ///< the level before Draco (point order of the source)
   DracoPrimitive primitive;   ///< the Draco bitstream and its decode
   std::string glb;            ///< the level alone as a .glb
 };
@@ -96,6 +111,18 @@ struct GltfLods {
 /// and InvalidArgument if a level has the wrong size.
 [[nodiscard]] Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
                                                const GltfLodOptions& options = {}, const ProgressFn& progress = {});
+
+/// The levels of detail of a consistent collection's members (one geometry image each, one
+/// size), every member's levels with the same connectivity: Adaptive simplifies all members at
+/// once in R^3n (adaptive_lods.h), so level k has the same faces, points and texture
+/// coordinates in every member (GltfLodLevel::mesh; Draco's decode order is then the same
+/// too). `options[m]` are member m's (names, provenance, error budget; the mode, levels and
+/// fraction of options[0] apply to all). Uniform: build_gltf_lods per member (subsampled
+/// images). Hole faces are kept (drop_hole_faces is ignored). Errors: those of
+/// build_gltf_lods and adaptive_lod_meshes; InvalidArgument (options not one per member).
+[[nodiscard]] Result<std::vector<GltfLods>> build_consistent_gltf_lods(const std::vector<GeometryImage>& members,
+                                                                      const std::vector<GltfLodOptions>& options,
+                                                                      const ProgressFn& progress = {});
 
 /// The images of `levels` levels of detail of `mesh` through its sphere map `S`: level 0 is
 /// `finest` (moved in), level k is sampled at (N-1)/2^k + 1 with `options` (so with

@@ -1,0 +1,57 @@
+// Adaptive levels of detail of a geometry-image remesh (issue 22): quadric edge-collapse
+// simplification instead of coarser uniform images, so the levels spend vertices where the
+// surface bends.
+//
+// The remesh of the finest image (geometry_image_mesh: a closed genus-0 manifold, one vertex
+// per welded texel) is simplified by libparam's progressive mesh (half-edge collapses at the
+// original positions, ordered by the n-D quadric, Garland & Heckbert 1998). Vertices keep
+// their positions, so every vertex of every level is a texel of the finest image and keeps
+// its texture coordinate exactly (gltf_mesh.h convention): one texture or normal map made from
+// the image serves every level.
+//
+// Seams. Texture coordinates jump where the octahedron folds (the border of the square
+// domain, welded pairwise, and its four corners, one vertex). Those border edges are given to
+// the simplifier as a path network (ProgressiveMeshOptions::constraint_edges): a border vertex
+// only collapses along the border into its border neighbour, the four fold ends (the side
+// midpoints) and the corner vertex never move. So no face ever spans the fold: each face lies
+// in the square, and a border vertex takes, per face, the copy (texel) that makes the face's
+// texture triangle smallest (the wrong copy is across the square).
+//
+// Collections (Asirvatham et al. 2005 §3, the R^3n mesh of step 4/5): the members' remeshes
+// share one connectivity (consistent maps: same texels), so ONE simplification of the mesh
+// whose vertex i is every member's vertex i stacked in R^3n gives every member the same
+// faces and points at every level; the n-D quadric measures the error of all members at once.
+// Each level's members therefore still make a morph-target glTF (gltf_morph.h).
+//
+// Level k has max(4, round(V * lod0_vertex_fraction / 4^k)) vertices, V the remesh's: the
+// uniform images' factor 4 per level.
+#pragma once
+
+#include <vector>
+
+#include "spherekit/convert/gltf_mesh.h"
+#include "spherekit/geometry_image.h"
+#include "spherekit/progress.h"
+#include "spherekit/status.h"
+
+namespace spherekit::convert {
+
+struct AdaptiveLodOptions {
+  int levels = 4;                     ///< >= 1
+  /// Vertices of level 0 as a fraction of the finest remesh's (0, 1]; each further level has a
+  /// quarter of the previous one's.
+  double lod0_vertex_fraction = 0.25;
+};
+
+/// The adaptive levels of one or more members (consistent geometry images of one size):
+/// result[k][m] is level k of member m as a glTF primitive (points = (vertex, texel) pairs,
+/// positions and normals of the member's image, TEXCOORD_0 of the finest image, position_index
+/// = the level's vertex). For every k all members have identical F, UV and position_index.
+/// Deterministic. Progress: stage "simplify" (from build_progressive_mesh). Errors:
+/// InvalidArgument (no member, sizes differ, malformed image, levels < 1, fraction not in
+/// (0, 1]), SolverFailed (simplification stuck), Cancelled.
+[[nodiscard]] Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector<GeometryImage>& members,
+                                                                            const AdaptiveLodOptions& options = {},
+                                                                            const ProgressFn& progress = {});
+
+}  // namespace spherekit::convert

@@ -1,0 +1,200 @@
+// Adaptive levels of detail by one n-D quadric simplification of the geometry-image remesh
+// (see adaptive_lods.h). References: Garland & Heckbert 1998 (n-D quadrics); Hoppe 1996
+// (half-edge collapses, replayed here up to each level's vertex count); Asirvatham, Praun &
+// Hoppe 2005 §3 (the R^3n mesh of a consistent collection).
+#include "spherekit/convert/adaptive_lods.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "spherekit/progressive_mesh.h"
+
+namespace spherekit::convert {
+namespace {
+
+// The folded border of the octahedral square as simplifier path edges (welded vertex ids):
+// consecutive texels along one side of the square. Each welded edge appears twice (once per
+// side of the fold); duplicates are removed.
+std::vector<std::array<int, 2>> seam_edges(int n, const std::vector<int>& welded) {
+  std::vector<std::array<int, 2>> edges;
+  auto add = [&](int i0, int j0, int i1, int j1) {
+    int a = welded[static_cast<std::size_t>(i0) * n + j0], b = welded[static_cast<std::size_t>(i1) * n + j1];
+    if (a == b) return;
+    edges.push_back({std::min(a, b), std::max(a, b)});
+  };
+  for (int s = 0; s + 1 < n; ++s) {
+    add(0, s, 0, s + 1);
+    add(n - 1, s, n - 1, s + 1);
+    add(s, 0, s + 1, 0);
+    add(s, n - 1, s + 1, n - 1);
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+// Per face corner, the copy (texel) of each corner's vertex that makes the face's triangle in
+// the texel grid smallest (perimeter): faces never span the fold, so the right copies are
+// neighbours in the square and any other choice reaches across it. Ties: the first candidate
+// in texel order (deterministic).
+std::array<int, 3> face_texels(const std::array<int, 3>& v, const std::vector<std::vector<int>>& copies, int n) {
+  const auto& c0 = copies[static_cast<std::size_t>(v[0])];
+  const auto& c1 = copies[static_cast<std::size_t>(v[1])];
+  const auto& c2 = copies[static_cast<std::size_t>(v[2])];
+  if (c0.size() == 1 && c1.size() == 1 && c2.size() == 1) return {c0[0], c1[0], c2[0]};
+  auto dist = [n](int a, int b) {
+    const double di = a / n - b / n, dj = a % n - b % n;
+    return std::sqrt(di * di + dj * dj);
+  };
+  std::array<int, 3> best{c0[0], c1[0], c2[0]};
+  double best_len = std::numeric_limits<double>::infinity();
+  for (int a : c0)
+    for (int b : c1)
+      for (int c : c2) {
+        const double len = dist(a, b) + dist(b, c) + dist(c, a);
+        if (len < best_len) {
+          best_len = len;
+          best = {a, b, c};
+        }
+      }
+  return best;
+}
+
+Status check_members(const std::vector<GeometryImage>& members, const AdaptiveLodOptions& options) {
+  if (members.empty()) return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: no member");
+  const int n = members[0].size;
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    const GeometryImage& g = members[m];
+    const auto texels = static_cast<std::size_t>(g.size) * static_cast<std::size_t>(g.size);
+    if (g.size != n || !is_geometry_image_size(n) || g.positions.size() != 3 * texels || g.normals.size() != 3 * texels)
+      return Status(ErrorCode::InvalidArgument,
+                    "adaptive levels of detail: member " + std::to_string(m) + " is not a " + std::to_string(n) +
+                        " x " + std::to_string(n) + " geometry image");
+  }
+  if (options.levels < 1 || options.levels > 16)
+    return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: levels must be in 1..16");
+  if (!(options.lod0_vertex_fraction > 0 && options.lod0_vertex_fraction <= 1))
+    return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: lod0 vertex fraction must be in (0, 1]");
+  return Status();
+}
+
+}  // namespace
+
+Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector<GeometryImage>& members,
+                                                              const AdaptiveLodOptions& options,
+                                                              const ProgressFn& progress) {
+  SPHEREKIT_RETURN_IF_ERROR(check_members(members, options));
+  const int n = members[0].size;
+  const auto nm = static_cast<int>(members.size());
+  int nv = 0;
+  const std::vector<int> welded = geometry_image_welded_ids(n, &nv);
+  std::vector<std::vector<int>> copies(static_cast<std::size_t>(nv));  // texels of each vertex, ascending
+  for (std::size_t t = 0; t < welded.size(); ++t) copies[static_cast<std::size_t>(welded[t])].push_back(static_cast<int>(t));
+
+  // The R^3n remesh: vertex v = every member's position of its texel (fold copies are equal).
+  RowMatXd P(nv, 3 * nm);
+  for (int v = 0; v < nv; ++v) {
+    const std::size_t t = static_cast<std::size_t>(copies[static_cast<std::size_t>(v)][0]);
+    for (int m = 0; m < nm; ++m)
+      for (int c = 0; c < 3; ++c) P(v, 3 * m + c) = members[static_cast<std::size_t>(m)].positions[3 * t + c];
+  }
+  const RowMat3i grid = geometry_image_grid_faces(n);
+  RowMat3i F(grid.rows(), 3);
+  for (Eigen::Index f = 0; f < grid.rows(); ++f)
+    for (int k = 0; k < 3; ++k) F(f, k) = welded[static_cast<std::size_t>(grid(f, k))];
+
+  ProgressiveMeshOptions pm_options;
+  pm_options.constraint_edges = seam_edges(n, welded);
+  // Fold ends (one seam edge) and the corner vertex (four) never move (progressive_mesh.h).
+  std::vector<int> on_seam(static_cast<std::size_t>(nv), 0);
+  for (const auto& e : pm_options.constraint_edges) {
+    ++on_seam[static_cast<std::size_t>(e[0])];
+    ++on_seam[static_cast<std::size_t>(e[1])];
+  }
+  pm_options.keep_vertices.assign(static_cast<std::size_t>(nv), 0);
+  for (int v = 0; v < nv; ++v)
+    pm_options.keep_vertices[static_cast<std::size_t>(v)] =
+        on_seam[static_cast<std::size_t>(v)] == 1 || on_seam[static_cast<std::size_t>(v)] > 2;
+  std::vector<int> targets;
+  for (int k = 0; k < options.levels; ++k)
+    targets.push_back(std::max(
+        6, static_cast<int>(std::lround(nv * options.lod0_vertex_fraction / std::pow(4.0, static_cast<double>(k))))));
+  pm_options.target_vertices = std::min(nv, targets.back());
+  SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, F, pm_options, progress));
+
+  // Replay the collapses up to each level's vertex count.
+  std::vector<int> parent(static_cast<std::size_t>(nv));
+  for (int v = 0; v < nv; ++v) parent[static_cast<std::size_t>(v)] = v;
+  auto find = [&parent](int v) {
+    while (parent[static_cast<std::size_t>(v)] != v) v = parent[static_cast<std::size_t>(v)];
+    return v;
+  };
+  std::vector<char> face_alive(static_cast<std::size_t>(F.rows()), 1);
+  std::size_t done = 0;
+  std::vector<std::vector<GltfMesh>> out;
+  for (int k = 0; k < options.levels; ++k) {
+    const std::size_t want = static_cast<std::size_t>(std::max(0, nv - targets[static_cast<std::size_t>(k)]));
+    for (; done < want && done < pm.collapses.size(); ++done) {
+      const HalfEdgeCollapse& c = pm.collapses[done];
+      parent[static_cast<std::size_t>(c.vt)] = c.vs;
+      for (int f : c.removed) face_alive[static_cast<std::size_t>(f)] = 0;
+    }
+    // Faces in input order, corners as texels; points = texels used, ascending.
+    std::vector<std::array<int, 3>> faces;
+    std::vector<char> used(welded.size(), 0);
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      if (!face_alive[static_cast<std::size_t>(f)]) continue;
+      const std::array<int, 3> v{find(F(f, 0)), find(F(f, 1)), find(F(f, 2))};
+      const std::array<int, 3> t = face_texels(v, copies, n);
+      for (int x : t) used[static_cast<std::size_t>(x)] = 1;
+      faces.push_back(t);
+    }
+    std::vector<int> point_of(welded.size(), -1), texel_of;
+    std::vector<int> vertex_rank(static_cast<std::size_t>(nv), -1);
+    int vertices = 0;
+    for (std::size_t t = 0; t < welded.size(); ++t) {
+      if (!used[t]) continue;
+      point_of[t] = static_cast<int>(texel_of.size());
+      texel_of.push_back(static_cast<int>(t));
+    }
+    GltfMesh shape;
+    shape.texture_size = n;
+    shape.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    for (std::size_t f = 0; f < faces.size(); ++f)
+      for (int c = 0; c < 3; ++c) shape.F(static_cast<Eigen::Index>(f), c) = point_of[static_cast<std::size_t>(faces[f][c])];
+    const auto np = static_cast<Eigen::Index>(texel_of.size());
+    shape.UV.resize(np, 2);
+    for (Eigen::Index p = 0; p < np; ++p) {
+      const int t = texel_of[static_cast<std::size_t>(p)];
+      shape.UV(p, 0) = (static_cast<double>(t % n) + 0.5) / n;
+      shape.UV(p, 1) = (static_cast<double>(t / n) + 0.5) / n;
+      int& r = vertex_rank[static_cast<std::size_t>(welded[static_cast<std::size_t>(t)])];
+      if (r < 0) r = vertices++;
+      shape.position_index.push_back(r);
+    }
+    std::vector<GltfMesh> level;
+    for (int m = 0; m < nm; ++m) {
+      const GeometryImage& g = members[static_cast<std::size_t>(m)];
+      GltfMesh mesh = shape;
+      mesh.V.resize(np, 3);
+      mesh.N.resize(np, 3);
+      for (Eigen::Index p = 0; p < np; ++p) {
+        const std::size_t t = static_cast<std::size_t>(texel_of[static_cast<std::size_t>(p)]);
+        for (int c = 0; c < 3; ++c) mesh.V(p, c) = g.positions[3 * t + c];
+        Eigen::Vector3d nrm(g.normals[3 * t], g.normals[3 * t + 1], g.normals[3 * t + 2]);
+        const double len = nrm.norm();
+        // As gltf_mesh_from_geometry_image: glTF NORMALs must be unit vectors.
+        nrm = len > 0 ? Eigen::Vector3d(nrm / len) : Eigen::Vector3d(0, 0, 1);
+        mesh.N.row(p) = nrm.transpose();
+      }
+      level.push_back(std::move(mesh));
+    }
+    out.push_back(std::move(level));
+  }
+  return out;
+}
+
+}  // namespace spherekit::convert

@@ -1,0 +1,99 @@
+// Tests of the adaptive levels of detail (convert/src/adaptive_lods.cpp, gltf_lods.cpp with
+// LodMode::Adaptive): one connectivity for every member of a collection per level, error
+// growing with the level, no face across the octahedral fold, determinism.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "gltf_test_support.h"
+#include "spherekit/convert/adaptive_lods.h"
+#include "spherekit/convert/gltf_lods.h"
+#include "spherekit/convert/gltf_morph.h"
+#include "test_meshes.h"
+
+using namespace spherekit;
+using namespace spherekit::convert;
+
+namespace {
+
+GltfLodOptions adaptive_options(int levels) {
+  GltfLodOptions o = test::lod_test_options();
+  o.mode = LodMode::Adaptive;
+  o.levels = levels;
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("Adaptive LODs of a collection: every member has the same connectivity at every level", "[convert]") {
+  const std::vector<GeometryImage> members{test::blob_geometry_image(33, 3, 7), test::blob_geometry_image(33, 3, 8),
+                                           test::blob_geometry_image(33, 3, 9)};
+  const std::vector<GltfLodOptions> options(3, adaptive_options(3));
+  auto built = build_consistent_gltf_lods(members, options);
+  REQUIRE(built.ok());
+  REQUIRE(built->size() == 3);
+  Eigen::Index previous_faces = 2 * 32 * 32 + 1;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const GltfLodLevel& a = (*built)[0].levels[k];
+    CHECK(a.mesh.F.rows() < previous_faces);  // coarser with the level
+    previous_faces = a.mesh.F.rows();
+    for (std::size_t m = 1; m < 3; ++m) {
+      const GltfLodLevel& b = (*built)[m].levels[k];
+      CHECK(a.mesh.F == b.mesh.F);
+      CHECK(a.mesh.UV == b.mesh.UV);
+      CHECK(a.mesh.position_index == b.mesh.position_index);
+      CHECK(a.mesh.V != b.mesh.V);  // different shapes, one connectivity
+      // Decoded index buffers (what a loader sees) are identical too.
+      CHECK(a.primitive.decoded.mesh.F == b.primitive.decoded.mesh.F);
+      CHECK(a.primitive.decoded.mesh.UV == b.primitive.decoded.mesh.UV);
+    }
+    // Each level's members still make one morph-target glTF.
+    std::vector<GltfMesh> level;
+    for (std::size_t m = 0; m < 3; ++m) level.push_back((*built)[m].levels[k].mesh);
+    auto morph = build_gltf_morph_targets(level);
+    CHECK(morph.ok());
+  }
+}
+
+TEST_CASE("Adaptive LODs: error grows with the level, no face spans the fold, deterministic", "[convert]") {
+  const GeometryImage gi = test::blob_geometry_image(65, 3, 7);
+  const TriMesh reference = geometry_image_mesh(gi);
+  auto built = build_gltf_lods(gi, adaptive_options(4));
+  REQUIRE(built.ok());
+  REQUIRE(built->levels.size() == 4);
+  RemeshErrorOptions eo;
+  eo.samples = 20000;
+  double previous = std::numeric_limits<double>::infinity();
+  for (const GltfLodLevel& level : built->levels) {
+    const GltfMesh& d = level.primitive.decoded.mesh;
+    const double psnr = remesh_psnr(reference, TriMesh{d.V, d.F}, eo);
+    INFO("faces " << d.F.rows() << " PSNR " << psnr);
+    CHECK(psnr < previous);
+    previous = psnr;
+    // Faces keep to one side of the fold: their texture triangles are small (a face reaching
+    // across the square would have an edge near 1).
+    double longest = 0;
+    for (Eigen::Index f = 0; f < level.mesh.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c)
+        longest = std::max(longest, (level.mesh.UV.row(level.mesh.F(f, c)) - level.mesh.UV.row(level.mesh.F(f, (c + 1) % 3))).norm());
+    CHECK(longest < 0.5);
+  }
+  CHECK(built->levels[0].mesh.F.rows() < reference.F.rows() / 2);
+  auto again = build_gltf_lods(gi, adaptive_options(4));
+  REQUIRE(again.ok());
+  CHECK(again->combined_glb == built->combined_glb);
+  for (std::size_t k = 0; k < 4; ++k) CHECK(again->levels[k].glb == built->levels[k].glb);
+}
+
+TEST_CASE("Adaptive LODs: bad options", "[convert]") {
+  AdaptiveLodOptions o;
+  CHECK(adaptive_lod_meshes({}, o).status().code() == ErrorCode::InvalidArgument);
+  o.lod0_vertex_fraction = 0;
+  CHECK(adaptive_lod_meshes({test::blob_geometry_image(17)}, o).status().code() == ErrorCode::InvalidArgument);
+  o.lod0_vertex_fraction = 0.25;
+  CHECK(adaptive_lod_meshes({test::blob_geometry_image(17), test::blob_geometry_image(33)}, o).status().code() ==
+        ErrorCode::InvalidArgument);
+  CHECK(build_consistent_gltf_lods({test::blob_geometry_image(17)}, {}).status().code() == ErrorCode::InvalidArgument);
+}

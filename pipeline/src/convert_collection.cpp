@@ -147,6 +147,50 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
           out.seconds = t.seconds();
           result.members.push_back(std::move(out));
         }
+        // Adaptive levels: one simplification of every member in R^3n (adaptive_lods.h), so level
+        // k has one connectivity in every member and each level is also a morph-target glTF.
+        if (o.lods > 0 && o.lod_mode == convert::LodMode::Adaptive) {
+          std::vector<GeometryImage> images;
+          std::vector<convert::GltfLodOptions> lod_options;
+          for (const ConvertedMember& c : result.members) {
+            convert::GltfLodOptions lo;
+            lo.mode = convert::LodMode::Adaptive;
+            lo.levels = o.lods;
+            lo.budget = o.budget;
+            lo.reference_rms_error = c.assets.measured ? c.assets.error.rms : 0;
+            lo.name = c.name;
+            lo.provenance = {c.source, info.dir};
+            images.push_back(c.assets.image);
+            lod_options.push_back(std::move(lo));
+          }
+          SPHEREKIT_ASSIGN_OR_RETURN(std::vector<convert::GltfLods> lods,
+                                     convert::build_consistent_gltf_lods(images, lod_options, progress));
+          RemeshErrorOptions psnr;
+          psnr.samples = o.psnr_samples;
+          for (std::size_t k = 0; k < result.members.size(); ++k) {
+            GeometryAssets& a = result.members[k].assets;
+            a.lods = std::move(lods[k]);
+            SPHEREKIT_ASSIGN_OR_RETURN(a.lod_paths,
+                                       convert::write_gltf_lods((fs::path(dir) / result.members[k].name).string(), a.lods));
+            if (a.measured)
+              for (const convert::GltfLodLevel& level : a.lods.levels)
+                a.lod_errors.push_back(
+                    remesh_error(members[k].mesh, TriMesh{level.primitive.decoded.mesh.V, level.primitive.decoded.mesh.F}, psnr));
+          }
+          for (int l = 0; result.members.size() >= 2 && l < o.lods; ++l) {
+            std::vector<convert::GltfMesh> meshes;
+            convert::GltfMorphOptions mo;
+            for (const ConvertedMember& c : result.members) {
+              meshes.push_back(c.assets.lods.levels[static_cast<std::size_t>(l)].mesh);
+              mo.names.push_back(c.name);
+            }
+            mo.provenance = {job.collection, info.dir};
+            SPHEREKIT_ASSIGN_OR_RETURN(auto morph, convert::build_gltf_morph_targets(meshes, mo));
+            const std::string file = "collection_morph_lod" + std::to_string(l) + ".glb";
+            SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic((fs::path(dir) / file).string(), morph.glb));
+            report["morph_lods"].push_back({{"file", file}, {"bytes", morph.glb.size()}, {"targets", morph.targets}});
+          }
+        }
         // One glTF with every member as a morph target of the first: possible only because
         // the consistent images share their texels, hence their vertices and faces.
         if (result.members.size() >= 2) {

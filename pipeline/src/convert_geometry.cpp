@@ -156,7 +156,10 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
   }
   // glTF levels of detail: the position bits come from the error budget of the image's own
   // remesh error (when measured), the PSNR of each level is that of the decoded glTF geometry.
-  if (o.lods > 0) {
+  // Adaptive levels of a collection member are built for all members at once (one
+  // connectivity, convert_collection).
+  const bool adaptive = o.lod_mode == convert::LodMode::Adaptive;
+  if (o.lods > 0 && !(adaptive && collection_member)) {
     Stopwatch gltf_time;
     convert::GltfLodOptions lo;
     lo.levels = o.lods;
@@ -167,9 +170,14 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
     // One mesh's levels show its holes; a member's keep the shared connectivity. Each level
     // is fitted at its own size.
     lo.drop_hole_faces = !collection_member;
-    auto level_images = convert::lod_geometry_images(mesh, S, out.image, o.lods, image_options(o));
-    if (!level_images.ok()) return with_file(level_images.status(), names.source_mesh);
-    SPHEREKIT_ASSIGN_OR_RETURN(out.lods, convert::build_gltf_lods(level_images.value(), lo, progress));
+    lo.mode = o.lod_mode;
+    if (adaptive) {
+      SPHEREKIT_ASSIGN_OR_RETURN(out.lods, convert::build_gltf_lods(out.image, lo, progress));
+    } else {
+      auto level_images = convert::lod_geometry_images(mesh, S, out.image, o.lods, image_options(o));
+      if (!level_images.ok()) return with_file(level_images.status(), names.source_mesh);
+      SPHEREKIT_ASSIGN_OR_RETURN(out.lods, convert::build_gltf_lods(level_images.value(), lo, progress));
+    }
     SPHEREKIT_ASSIGN_OR_RETURN(out.lod_paths, convert::write_gltf_lods(names.prefix, out.lods));
     out.times.gltf = gltf_time.seconds();
     if (out.measured) {

@@ -81,7 +81,7 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
       auto morph = build_gltf_morph_targets(
           std::vector<GltfMesh>{(*collection)[0].levels[k].mesh, (*collection)[1].levels[k].mesh});
       REQUIRE(morph.ok());
-      write("adaptive_morph_lod" + std::to_string(k) + ".glb", morph->glb);
+      write("adaptive_morph_plain_lod" + std::to_string(k) + ".glb", morph->glb);
     }
   }
 

@@ -135,6 +135,11 @@ void register_convert(CLI::App& app) {
   cmd->add_option("--psnr-samples", args->options.psnr_samples,
                   "points sampled per direction for the PSNR (0: skip it; default 400000)");
   cmd->add_option("--lods", args->options.lods, "also write this many glTF levels of detail (default 0: none)");
+  cmd->add_option("--lod-mode", args->options.lod_mode,
+                  "glTF levels: uniform (coarser geometry images, default) or adaptive (quadric simplification "
+                  "of the remesh; a collection's members share each level's connectivity)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, convert::LodMode>{
+          {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}}));
   cmd->add_option("--min-position-bits", args->options.budget.min_position_bits,
                   "glTF: fewest Draco position bits (default 14; more if the error budget needs them)");
   cmd->add_option("--normal-bits", args->options.budget.normal_bits, "glTF: Draco normal bits (default 10)");

@@ -36,6 +36,9 @@ struct ConvertOptions {
   TexelPositions positions = TexelPositions::Fit;
   int psnr_samples = RemeshErrorOptions{}.samples;  ///< per direction; 0: no PSNR
   int lods = 0;                                     ///< glTF levels of detail (0: none)
+  /// How the levels are made (gltf_lods.h). Uniform by default: measured against gltfpack and
+  /// gltf-transform at equal PSNR (issue 22), the adaptive levels do not win yet.
+  convert::LodMode lod_mode = convert::LodMode::Uniform;
   convert::QuantizationBudget budget;               ///< their Draco quantization
   int cage = 0;                                     ///< cage quads per cube-face edge (0: no cage)
   int cage_tile = 17;                               ///< displacement samples per quad edge

@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdarg>
 #include <cstdio>
+#include <sstream>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -182,6 +183,12 @@ Status write_json_atomic(const std::string& path, const Json& json) {
 
 
 std::string file_stem(const std::string& path) { return fs::path(path).stem().string(); }
+std::vector<std::string> words(const std::string& s) {
+  std::istringstream in(s);
+  std::vector<std::string> out;
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
 std::string file_name(const std::string& path) { return fs::path(path).filename().string(); }
 
 Table::Table(std::vector<std::string> header) { rows_.push_back(std::move(header)); }

@@ -161,6 +161,8 @@ Status write_json_atomic(const std::string& path, const Json& json);
 
 /// File name without folder and last extension ("a/b/spot.obj" -> "spot").
 std::string file_stem(const std::string& path);
+/// The whitespace-separated words of `s` (a flag holding another command's options).
+std::vector<std::string> words(const std::string& s);
 /// File name without folder ("a/b/spot.obj" -> "spot.obj").
 std::string file_name(const std::string& path);
 

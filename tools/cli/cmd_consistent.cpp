@@ -10,6 +10,7 @@
 
 #include "cli_common.h"
 #include "commands.h"
+#include "help_text.h"
 #include "spherekit/pipeline/collection.h"
 
 namespace spherekit::cli {
@@ -84,17 +85,7 @@ int run_add(const AddArgs& a) {
     rep["peak_rss_mb"] = peak_rss_mb();
     if (Status s = write_json_atomic(a.report, rep); !s.ok()) return print_error(s);
   }
-  if (!a.quiet && r->registered) {
-    std::printf("%s -> %s (registered; %zu features on the collection's locations)\n", job.mesh.c_str(),
-                r->map_path.c_str(), r->features);
-    std::printf("  efficiency %.4f, max feature error %.2g rad\n", r->map.efficiency, r->map.max_feature_angle);
-  } else if (!a.quiet) {
-    const ConstrainedParamResult& m = r->map;
-    std::printf("%s -> %s (%zu features on the collection's locations)\n", job.mesh.c_str(), r->map_path.c_str(), r->features);
-    std::printf("  efficiency %.4f, flipped faces %d, max feature error %.2g rad, %d paths, %d Steiner vertices\n",
-                m.efficiency, m.flipped_faces, m.max_feature_angle, m.network.paths, m.network.steiner_vertices);
-    std::printf("  time %.2f s (wall %.2f s), peak memory %.0f MB\n", m.times.total, r->wall_seconds, peak_rss_mb());
-  }
+  if (!a.quiet) print_add_summary(r.value(), job);
   return 0;
 }
 
@@ -104,20 +95,7 @@ void register_consistent(CLI::App& app) {
   auto args = std::make_shared<ConsistentArgs>();
   CLI::App* cmd = add_command(
       app, "consistent", "Map a collection of meshes consistently onto one sphere (features coincide)",
-      "Consistent spherical parameterization (Asirvatham, Praun, Hoppe 2005): every mesh is mapped\n"
-      "bijectively onto the unit sphere so that corresponding features (same names in the meshes'\n"
-      "feature files, `name vertex` lines) land on the same sphere points. Then two surface points\n"
-      "correspond when their sphere points are equal ('spherekit correspond').\n"
-      "Steps: 1 unconstrained map of the reference (its features give F'); 2 constrained maps of\n"
-      "the others to F'; 3 remesh all as octahedral geometry images, features snapped; 4 one mesh\n"
-      "in R^3n; 5 its unconstrained map (n-D quadric, summed stretch) gives the final locations F;\n"
-      "6 constrained maps of all meshes to F. --no-refine-locations stops after step 2.\n"
-      "Writes the folder -o DIR: collection.json (manifest), features.txt (`name x y z`: F) and\n"
-      "<stem>.sphere.obj per mesh; DIR is replaced only when everything succeeded. Feature files\n"
-      "default to NAME.lm.txt beside each mesh. Without meshes, the built-in sample collection.",
-      "  spherekit consistent -o cats cat0.obj cat2.obj cat5.obj cat9.obj\n"
-      "  spherekit consistent -o pair bunny.obj gargoyle.obj --features bunny.lm.txt gargoyle.lm.txt\n"
-      "  spherekit consistent -o samples-collection          # the built-in samples");
+      help::kConsistent, help::kConsistentExamples);
   cmd->add_option("MESH", args->job.meshes, "input meshes (genus 0, holes allowed)");
   cmd->add_option("-o,--output", args->job.output, "collection folder to write")->required();
   cmd->add_option("--features", args->job.features, "feature files, one per mesh in order (default: MESH stem + .lm.txt)");
@@ -137,16 +115,7 @@ void register_consistent(CLI::App& app) {
   auto add_args = std::make_shared<AddArgs>();
   CLI::App* add = add_command(
       app, "add", "Map a new mesh into an existing collection (its features on the collection's)",
-      "Constrained spherical parameterization of MESH with its features exactly on the collection's\n"
-      "feature locations F (the paper's way to grow a database without recomputing it, §5). The\n"
-      "feature file (default NAME.lm.txt beside the mesh) must name every feature of the\n"
-      "collection. Writes DIR/<stem>.sphere.obj and updates collection.json under the folder's lock\n"
-      "(DIR/.collection.lock, held only around the manifest update), so that concurrent adds, e.g. the\n"
-      "tasks of a job array, all land. Reads only the manifest and F, not the other members' maps.\n"
-      "Members are kept sorted by name.",
-      "  spherekit add cats cat10.obj\n"
-      "  spherekit add cats scan.ply --features scan.lm.txt --name cat_scan\n"
-      "  spherekit add cats cat11.obj --map cat11.sphere.obj   # computed elsewhere, verified");
+      help::kAdd, help::kAddExamples);
   add->add_option("DIR", add_args->job.dir, "collection folder")->required();
   add->add_option("MESH", add_args->job.mesh, "mesh to add")->required();
   add->add_option("--features", add_args->job.features, "its feature file (default: MESH stem + .lm.txt)");

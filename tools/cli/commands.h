@@ -13,10 +13,15 @@ class App;
 
 namespace spherekit {
 struct SphereParamOptions;
+namespace scheduler {
+struct CollectionPlanOptions;
+}
 namespace pipeline {
 struct ConvertCollectionResult;
 struct ConvertMeshResult;
 struct MakeCollectionResult;
+struct AddToCollectionJob;
+struct AddToCollectionResult;
 struct TransferJob;
 struct TransferResult;
 struct MorphJob;
@@ -52,6 +57,11 @@ void print_collection_summary(const pipeline::ConvertCollectionResult& result);
 void print_collection_warning(const pipeline::MakeCollectionResult& result);
 void print_consistent_summary(const pipeline::MakeCollectionResult& result, const std::string& output,
                               double wall_seconds);
+/// What `add` prints (a registered map or a computed one).
+void print_add_summary(const pipeline::AddToCollectionResult& result, const pipeline::AddToCollectionJob& job);
+/// The plan line `submit` prints on stderr before running: members, the subset, its memory.
+void print_submit_plan(const scheduler::CollectionPlanOptions& options, int k_memory, double joint_memory_mb,
+                       int remesh_size, const std::string& scheduler_name);
 
 /// The summaries `transfer`, `morph` and `pca` print (the main job prints them too).
 void print_transfer_summary(const pipeline::TransferResult& result, const pipeline::TransferJob& job);

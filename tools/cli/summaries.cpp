@@ -9,6 +9,7 @@
 #include "spherekit/pipeline/apps.h"
 #include "spherekit/pipeline/collection.h"
 #include "spherekit/pipeline/convert.h"
+#include "spherekit/scheduler/collection_plan.h"
 
 namespace spherekit::cli {
 namespace {
@@ -84,6 +85,32 @@ void print_collection_warning(const pipeline::MakeCollectionResult& r) {
   if (!r.refinement_warning.empty())
     std::fprintf(stderr, "spherekit: warning: step 6 failed (%s); the collection keeps the step-2 maps (locations from the reference)\n",
                  r.refinement_warning.c_str());
+}
+
+void print_submit_plan(const scheduler::CollectionPlanOptions& o, int k_memory, double joint_memory_mb, int remesh,
+                       const std::string& scheduler_name) {
+  const int n = static_cast<int>(o.meshes.size()), k = static_cast<int>(o.subset.size());
+  std::string names;
+  for (int i : o.subset) names += (names.empty() ? "" : " ") + o.names[static_cast<size_t>(i)];
+  std::fprintf(stderr,
+               "submit: %d members; F from %d (%s), joint-step quadrics %.0f MB (k <= %d fit in %.0f MB); "
+               "%d maps as independent tasks; scheduler %s; plan %s/plan.json\n",
+               n, k, names.c_str(), scheduler::joint_quadric_bytes(k, remesh) / (1024 * 1024), k_memory,
+               joint_memory_mb, n - k, scheduler_name.c_str(), o.work_dir.c_str());
+}
+
+void print_add_summary(const pipeline::AddToCollectionResult& r, const pipeline::AddToCollectionJob& job) {
+  if (r.registered) {
+    std::printf("%s -> %s (registered; %zu features on the collection's locations)\n", job.mesh.c_str(),
+                r.map_path.c_str(), r.features);
+    std::printf("  efficiency %.4f, max feature error %.2g rad\n", r.map.efficiency, r.map.max_feature_angle);
+    return;
+  }
+  const ConstrainedParamResult& m = r.map;
+  std::printf("%s -> %s (%zu features on the collection's locations)\n", job.mesh.c_str(), r.map_path.c_str(), r.features);
+  std::printf("  efficiency %.4f, flipped faces %d, max feature error %.2g rad, %d paths, %d Steiner vertices\n",
+              m.efficiency, m.flipped_faces, m.max_feature_angle, m.network.paths, m.network.steiner_vertices);
+  std::printf("  time %.2f s (wall %.2f s), peak memory %.0f MB\n", m.times.total, r.wall_seconds, peak_rss_mb());
 }
 
 void print_consistent_summary(const pipeline::MakeCollectionResult& c, const std::string& output, double wall_seconds) {

@@ -5,6 +5,53 @@
 
 namespace spherekit::cli::help {
 
+// `spherekit convert` (single mesh and --collection).
+inline constexpr const char* kConvert =
+    "Resample a mesh through its sphere map (as written by `spherekit param`) into an N x N\n"
+    "octahedral geometry image (N = 2^k+1): each texel's sphere point is located in the sphere\n"
+    "map and the surface position and normal are interpolated there. Writes a float EXR\n"
+    "(R,G,B = position, N.X,N.Y,N.Z = normal, face_id; ZIP; provenance in the header), and\n"
+    "with --remesh the triangle mesh the image defines (holes of the mesh left open), and two\n"
+    "PNG previews of the image,\n"
+    "OUT_normals.png (normals as colours) and OUT_positions.png (positions in the bounding\n"
+    "box as colours; texels in holes of the mesh at half brightness). Prints the remesh PSNR against the\n"
+    "original (peak = bounding-box diagonal, symmetric RMS surface distance; for a mesh with\n"
+    "holes without the remesh faces that have two or three texels in a hole); --report writes\n"
+    "it with the timings as JSON. With --lods L it also writes L levels of detail (image sizes\n"
+    "N, (N-1)/2+1, ..., each resampled and fitted at its own size; faces spanning holes of the\n"
+    "mesh left out) as Draco-compressed glTF (POSITION, NORMAL, TEXCOORD_0 = texel centres\n"
+    "of the image): OUT_lod0.glb ... one per level, and OUT_lods.glb with all of them (MSFT_lod,\n"
+    "level 0 shown by viewers without it), OUT being -o without its extension. Position bits:\n"
+    "the fewest >= --min-position-bits whose quantization error is at most a tenth of the\n"
+    "measured remesh error (recorded in the glTF extras and the report, with each level's\n"
+    "size and the PSNR of its decoded geometry). The mesh must be one `param` accepts and the\n"
+    "map a bijection (no face flipped by the exact predicate).\n"
+    "With --cage N it also fits a Catmull-Clark base cage defined on the sphere domain (the\n"
+    "cube, N x N quads per face, 6N^2 quads, the same for every mesh: in a consistent\n"
+    "collection cage vertex k is the same place on every member) whose limit surface\n"
+    "(OpenSubdiv) best fits the mesh, writes it as OUT_cage.obj with texture coordinates, and\n"
+    "samples the displacement from the limit surface to the mesh on a T x T grid per quad\n"
+    "(--cage-tile T) into one float EXR texture over the cage's UVs, OUT_disp.exr, that DCC\n"
+    "tools apply as is (Blender: blender -b -P scripts/blender_setup_cage.py -- OUT_cage.obj\n"
+    "OUT_disp.exr OUT.blend; T = 2^L+1 for L subdivision levels; see README). It reports the PSNR of the\n"
+    "bare limit surface and of the displaced one.\n"
+    "With --collection DIR (instead of MESH SPHERE) every member of a consistent collection is\n"
+    "converted with the same options into the folder -o: NAME.exr, NAME_normals.png,\n"
+    "NAME_positions.png, NAME_lod*.glb, NAME_cage.obj,\n"
+    "NAME_disp.exr per member, collection_morph.glb (one glTF, the members as morph targets),\n"
+    "and convert_report.json (per member sizes and PSNRs, and per feature the texel that holds\n"
+    "it in every image). All members share one layout: the same texel, cage vertex, glTF\n"
+    "vertex is the same place on every member. The folder appears only when complete.\n"
+    "Exit codes: 2 bad flags (e.g.\n"
+    "--size not 2^k+1), 3 bad input (including a folded map), 4 I/O error.";
+inline constexpr const char* kConvertExamples =
+    "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr\n"
+    "  spherekit convert bunny.obj bunny.sphere.obj -o bunny.exr --size 129 --remesh bunny.gim.obj\n"
+    "  spherekit convert igea.ply igea.sphere.obj -o igea.exr --report igea.convert.json\n"
+    "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --size 257 --lods 4\n"
+    "  spherekit convert bunny.obj bunny.sphere.obj -o out/bunny.exr --cage 8 --cage-tile 33\n"
+    "  spherekit convert --collection heads/ -o heads_assets/ --size 129 --lods 3 --cage 8";
+
 // `spherekit consistent` (paper §3).
 inline constexpr const char* kConsistent =
     "Consistent spherical parameterization (Asirvatham, Praun, Hoppe 2005): every mesh is mapped\n"

@@ -268,6 +268,24 @@ TEST_CASE("malformed inputs fail with one line, no output, no temp files", "[cli
   CHECK(files_in(out_dir).empty());
 }
 
+TEST_CASE("param --report - writes the report to standard output, no file named -", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_report_stdout");
+  const std::string out_dir = dir + "/out";
+  fs::create_directories(out_dir);
+  const std::string mesh = write_obj(dir, "blob.obj", spherekit::test::random_blob(2, 5));
+  CliRun p = run_cli("param " + quote(mesh) + " -o " + quote(out_dir + "/blob.sphere.obj") +
+                         " --report - --effort 0 --quiet", out_dir);
+  INFO("stderr: " << p.err);
+  REQUIRE(p.exit_code == 0);
+  CHECK_FALSE(fs::exists(fs::current_path() / "-"));  // the command runs in the test's directory
+  // The report is the last JSON object on stdout (the summary comes before it).
+  const size_t start = p.out.find("{\n");
+  REQUIRE(start != std::string::npos);
+  json r = json::parse(p.out.substr(start), nullptr, false);
+  REQUIRE_FALSE(r.is_discarded());
+  CHECK(r["flipped_faces"] == 0);
+}
+
 TEST_CASE("param writes a bijective unit sphere map and eval agrees", "[cli]") {
   const std::string dir = spherekit::test::temp_dir("cli_param");
   const std::string out_dir = dir + "/out";

@@ -192,7 +192,7 @@ TEST_CASE("sample collection options are validated", "[param][samples]") {
   samples::SampleCollectionOptions options;
   options.members = 0;
   CHECK(samples::make_sample_collection(options).status().code() == ErrorCode::InvalidArgument);
-  options.members = 9;
+  options.members = 1001;  // up to 1000 (sample_a .. sample_zz, then three letters)
   CHECK(samples::make_sample_collection(options).status().code() == ErrorCode::InvalidArgument);
   options.members = 1;
   options.target_vertices = 50;

@@ -178,7 +178,14 @@ bool ProgressRenderer::on_event(const ProgressEvent& event) {
 
 Status write_json_atomic(const std::string& path, const Json& json) {
   // Non-finite doubles become null (nlohmann's choice), which every JSON reader accepts.
-  return formats::write_file_atomic(path, json.dump(2) + "\n");
+  const std::string text = json.dump(2) + "\n";
+  // "-" is standard output, as for every Unix tool (`--report -`): a script pipes the report on.
+  if (path == "-") {
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+      return Status(ErrorCode::IoError, "standard output: cannot write the report");
+    return Status();
+  }
+  return formats::write_file_atomic(path, text);
 }
 
 

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <unistd.h>
 
 #include "cli_runner.h"
 #include "cli_shorthands.h"
@@ -42,7 +43,9 @@ const BlenderInfo& blender_info() {
     BlenderInfo b;
     const char* env = std::getenv("SPHEREKIT_BLENDER");
     const std::string exe = env && *env ? env : "blender";
-    const std::string dir = test::temp_dir("blender_version");
+    // One folder per process: ctest runs the two Blender cases at once, and temp_dir empties
+    // its folder first (a shared one let one case read the other's half-written output).
+    const std::string dir = test::temp_dir("blender_version_" + std::to_string(::getpid()));
     const int rc = test::run_shell(q(exe) + " --version", dir + "/out.txt", dir + "/err.txt");
     const std::string out = test::slurp(dir + "/out.txt");
     if (rc != 0 || out.rfind("Blender ", 0) != 0) {

@@ -5,7 +5,7 @@
 #   bash scripts/fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]     (default 600 s, all harnesses)
 #   bash scripts/fuzz.sh 60 ply obj                              (one minute each for two)
 #
-# Harnesses: obj ply off stl gltf glb landmarks sphere_points targets sphere_map attributes
+# Harnesses: obj ply off stl gltf glb compressed landmarks sphere_points targets sphere_map attributes
 # collection.
 # The seeds (tools/fuzz/corpus/NAME) are copied into build-fuzz/corpus/NAME, which keeps
 # growing across runs; the source tree is never written. A crash, leak, sanitizer report,
@@ -19,7 +19,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 seconds="${1:-600}"
 [[ "$seconds" =~ ^[0-9]+$ ]] || { echo "fuzz.sh: SECONDS must be a whole number, got '$seconds'" >&2; exit 2; }
 shift || true
-all=(obj ply off stl gltf glb landmarks sphere_points targets sphere_map attributes collection)
+all=(obj ply off stl gltf glb compressed landmarks sphere_points targets sphere_map attributes collection)
 harnesses=("$@")
 [ ${#harnesses[@]} -gt 0 ] || harnesses=("${all[@]}")
 for h in "${harnesses[@]}"; do

@@ -19,7 +19,7 @@ done
 packages=(
   cmake g++ ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libcli11-dev catch2 zlib1g-dev
-  libosd-dev libopenexr-dev libtinygltf-dev libdraco-dev libstb-dev
+  libosd-dev libopenexr-dev libtinygltf-dev libdraco-dev libmeshoptimizer-dev libstb-dev
   # the Python module (python/): pybind11 and the interpreter's headers; numpy arrays in and out
   python3-dev python3-pybind11 python3-numpy python3-scipy
 )

@@ -3,9 +3,15 @@
 //
 // What is read: every triangle primitive (mode 4 or absent) of every mesh reached from the
 // default scene's nodes, with the node's world transform applied (or all meshes untransformed
-// when the file has no scenes). Positions must be float VEC3; indices u8/u16/u32 or absent.
-// Points and lines are not surfaces and are skipped; strips, fans, sparse accessors and
-// compressed primitives (Draco, meshopt) are Unsupported.
+// when the file has no scenes). Positions are VEC3 float, or with KHR_mesh_quantization
+// (signed or unsigned) byte/short, normalized or not; they are dequantized through the node
+// transform as the extension requires (gltfpack puts its dequantization scale and offset in
+// the node's matrix). Indices u8/u16/u32 or absent. Compressed geometry is decoded
+// (gltf_compression.h): KHR_draco_mesh_compression primitives, whose decoded point and index
+// counts must match their accessors (KHR_draco_mesh_compression README, "Conformance"), and
+// EXT_meshopt_compression / KHR_meshopt_compression bufferViews (read through their fallback
+// buffer's place). Points and lines are not surfaces and are skipped; strips, fans and sparse
+// accessors are Unsupported.
 //
 // glTF splits a vertex wherever any attribute differs (normal creases, UV seams, material
 // boundaries between primitives), so one surface point appears as several vertices with
@@ -20,6 +26,7 @@
 #include <vector>
 
 #include "byte_reader.h"
+#include "gltf_compression.h"
 #include "gltf_uri.h"
 #include "mesh_builder.h"
 #include "mesh_codecs.h"
@@ -67,7 +74,35 @@ struct AccessorView {
   std::uint64_t count = 0;
   std::size_t stride = 0;
   std::uint64_t component_type = 0;
+  bool normalized = false;
 };
+
+/// Component `k` of element `i` as a number: integers as they are, or mapped to [0, 1] /
+/// [-1, 1] when normalized (glTF 2.0, 3.11 "Animations" table of normalized conversions:
+/// c / (2^n - 1) unsigned, max(c / (2^(n-1) - 1), -1) signed).
+double read_component(const AccessorView& a, std::uint64_t i, int k) {
+  const char* p = a.data + i * a.stride + static_cast<std::size_t>(k) * component_size(a.component_type);
+  switch (a.component_type) {
+    case 5120: {
+      const double c = load_scalar<std::int8_t>(p, false);
+      return a.normalized ? std::max(c / 127.0, -1.0) : c;
+    }
+    case kUnsignedByte: {
+      const double c = load_scalar<std::uint8_t>(p, false);
+      return a.normalized ? c / 255.0 : c;
+    }
+    case 5122: {
+      const double c = load_scalar<std::int16_t>(p, false);
+      return a.normalized ? std::max(c / 32767.0, -1.0) : c;
+    }
+    case kUnsignedShort: {
+      const double c = load_scalar<std::uint16_t>(p, false);
+      return a.normalized ? c / 65535.0 : c;
+    }
+    case kUnsignedInt: return load_scalar<std::uint32_t>(p, false);
+    default: return load_scalar<float>(p, false);
+  }
+}
 
 class GltfReader {
  public:
@@ -79,6 +114,8 @@ class GltfReader {
     if (!doc_.is_object()) fail(ErrorCode::ParseError, path_ + ": glTF JSON root is not an object");
     check_version_and_extensions();
     buffers_.resize(array(doc_, "buffers", "document").size());
+    // Sized once: buffer_view_bytes hands out views into these strings.
+    decoded_views_.resize(array(doc_, "bufferViews", "document").size());
     const json& meshes = array(doc_, "meshes", "document");
     const json& scenes = array(doc_, "scenes", "document");
     if (scenes.empty()) {
@@ -153,18 +190,9 @@ class GltfReader {
         }
       }
     }
-    // Compressed geometry cannot be read without its decoder; other required extensions
-    // (materials, textures) do not change positions or triangles.
-    for (const json& ext : array(doc_, "extensionsRequired", "document")) {
-      if (!ext.is_string()) continue;
-      const std::string name = ext.get<std::string>();
-      if (name == "KHR_draco_mesh_compression" || name == "EXT_meshopt_compression" ||
-          name == "KHR_meshopt_compression") {
-        fail(ErrorCode::Unsupported, path_ + ": requires " + name +
-                                         " (compressed meshes are not supported; decompress first, e.g. "
-                                         "gltf-transform copy)");
-      }
-    }
+    // Required extensions are not checked: the geometry ones (Draco, meshopt, quantization)
+    // are decoded where they appear, and the others (materials, textures, lights) do not
+    // change positions or triangles.
   }
 
   /// Depth-first over the scene's node trees, composing transforms parent * local.
@@ -249,12 +277,6 @@ class GltfReader {
   }
 
   void add_primitive(const json& prim, const Eigen::Matrix4d& world, const std::string& where) {
-    auto ext = prim.find("extensions");
-    if (ext != prim.end() && ext->is_object() && ext->contains("KHR_draco_mesh_compression")) {
-      fail(ErrorCode::Unsupported, path_ + ": " + where +
-                                       " is Draco-compressed (KHR_draco_mesh_compression is not supported; "
-                                       "decompress first, e.g. gltf-transform copy)");
-    }
     const std::uint64_t mode = uint_field(prim, "mode", 4, where);
     if (mode < 4) return;  // points and lines: no surface
     if (mode == 5 || mode == 6) {
@@ -268,10 +290,15 @@ class GltfReader {
       fail(ErrorCode::ParseError, path_ + ": " + where + " has no POSITION attribute");
     }
     const std::uint64_t pos_index = uint_field(*attributes, "POSITION", -1, where);
+    auto ext = prim.find("extensions");
+    if (ext != prim.end() && ext->is_object() && ext->contains("KHR_draco_mesh_compression")) {
+      add_draco_primitive(prim, (*ext)["KHR_draco_mesh_compression"], pos_index, world, where);
+      return;
+    }
     const AccessorView pos = accessor(pos_index, "VEC3", where + " POSITION");
-    if (pos.component_type != kFloat) {
-      fail(ErrorCode::Unsupported, path_ + ": " + where + " POSITION has component type " +
-                                       std::to_string(pos.component_type) + " (only float is supported)");
+    if (pos.component_type == kUnsignedInt) {
+      fail(ErrorCode::ParseError, path_ + ": " + where + " POSITION has component type unsigned int (glTF allows "
+                                      "float, and byte or short with KHR_mesh_quantization)");
     }
     AccessorView idx;
     const bool indexed = prim.contains("indices");
@@ -302,19 +329,75 @@ class GltfReader {
                                             std::to_string(pos.count) + " vertices)");
         }
         if (welded[v] < 0) {
-          const char* p = pos.data + v * pos.stride;
-          Eigen::Vector4d x(load_scalar<float>(p, false), load_scalar<float>(p + 4, false),
-                            load_scalar<float>(p + 8, false), 1.0);
-          const Eigen::Vector4d y = world * x;
-          Status s = welder_.add(y[0], y[1], y[2], welded[v]);
-          if (!s.ok()) fail(s.code(), s.message());
+          welded[v] = add_vertex(world, read_component(pos, v, 0), read_component(pos, v, 1), read_component(pos, v, 2));
         }
         corners[k] = welded[v];
       }
-      if (mirrored) std::swap(corners[1], corners[2]);
-      Status s = builder_.add_face(corners, 3, FaceSource::element(face_count_++));
-      if (!s.ok()) fail(s.code(), s.message());
+      add_triangle(corners, mirrored);
     }
+  }
+
+  /// A KHR_draco_mesh_compression primitive: decode the bufferView with Draco's core decoder;
+  /// the primitive's accessors describe the decoded data (their counts must match it).
+  void add_draco_primitive(const json& prim, const json& draco, std::uint64_t pos_index, const Eigen::Matrix4d& world,
+                           const std::string& where) {
+    const std::string ext_where = where + " KHR_draco_mesh_compression";
+    if (!draco.is_object()) fail(ErrorCode::ParseError, path_ + ": " + ext_where + " is not an object");
+    const std::uint64_t view = uint_field(draco, "bufferView", -1, ext_where);
+    auto attributes = draco.find("attributes");
+    if (attributes == draco.end() || !attributes->is_object() || !attributes->contains("POSITION"))
+      fail(ErrorCode::ParseError, path_ + ": " + ext_where + " has no POSITION attribute");
+    const std::uint64_t uid = uint_field(*attributes, "POSITION", -1, ext_where);
+    if (uid > 0xffffffffu) fail(ErrorCode::ParseError, path_ + ": " + ext_where + ": POSITION id out of range");
+    Result<DracoPositions> decoded = decode_draco_positions(buffer_view_bytes(view), static_cast<std::uint32_t>(uid));
+    if (!decoded.ok()) {
+      fail(decoded.status().code(), path_ + ": " + ext_where + " (bufferView " + std::to_string(view) +
+                                        "): " + decoded.status().message());
+    }
+    const DracoPositions& d = decoded.value();
+    const std::uint64_t points = d.xyz.size() / 3;
+    // Counts only: the accessors have no data of their own (no bufferView).
+    const std::uint64_t pos_count = uint_field(element("accessors", pos_index, where), "count", -1,
+                                               "accessor " + std::to_string(pos_index));
+    if (pos_count != points) {
+      fail(ErrorCode::ParseError, path_ + ": " + where + " POSITION accessor count " + std::to_string(pos_count) +
+                                      " != Draco decoded points " + std::to_string(points));
+    }
+    if (prim.contains("indices")) {
+      const std::uint64_t idx_index = uint_field(prim, "indices", -1, where);
+      const std::uint64_t idx_count = uint_field(element("accessors", idx_index, where), "count", -1,
+                                                 "accessor " + std::to_string(idx_index));
+      if (idx_count != d.triangles.size()) {
+        fail(ErrorCode::ParseError, path_ + ": " + where + " indices accessor count " + std::to_string(idx_count) +
+                                        " != Draco decoded corners " + std::to_string(d.triangles.size()));
+      }
+    }
+    const bool mirrored = world.topLeftCorner<3, 3>().determinant() < 0;
+    std::vector<std::int64_t> welded(points, -1);
+    for (std::size_t t = 0; t < d.triangles.size() / 3; ++t) {
+      std::int64_t corners[3];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t v = d.triangles[3 * t + static_cast<std::size_t>(k)];
+        if (welded[v] < 0) welded[v] = add_vertex(world, d.xyz[3 * v], d.xyz[3 * v + 1], d.xyz[3 * v + 2]);
+        corners[k] = welded[v];
+      }
+      add_triangle(corners, mirrored);
+    }
+  }
+
+  /// The welded mesh vertex at world * (x, y, z).
+  std::int64_t add_vertex(const Eigen::Matrix4d& world, double x, double y, double z) {
+    const Eigen::Vector4d p = world * Eigen::Vector4d(x, y, z, 1.0);
+    std::int64_t index = -1;
+    Status s = welder_.add(p[0], p[1], p[2], index);
+    if (!s.ok()) fail(s.code(), s.message());
+    return index;
+  }
+
+  void add_triangle(std::int64_t (&corners)[3], bool mirrored) {
+    if (mirrored) std::swap(corners[1], corners[2]);
+    Status s = builder_.add_face(corners, 3, FaceSource::element(face_count_++));
+    if (!s.ok()) fail(s.code(), s.message());
   }
 
   static std::uint64_t read_index(const AccessorView& a, std::uint64_t i) {
@@ -344,19 +427,18 @@ class GltfReader {
                                       std::to_string(view.component_type));
     }
     view.count = uint_field(acc, "count", -1, name);
+    if (auto n = acc.find("normalized"); n != acc.end()) {
+      if (!n->is_boolean()) fail(ErrorCode::ParseError, path_ + ": " + name + ": 'normalized' is not a boolean");
+      view.normalized = n->get<bool>();
+    }
     if (!acc.contains("bufferView")) {
       fail(ErrorCode::Unsupported, path_ + ": " + name + " has no bufferView (implicit zeros are not supported)");
     }
     const std::uint64_t bv_index = uint_field(acc, "bufferView", -1, name);
     const std::string bv_name = "bufferView " + std::to_string(bv_index);
     const json& bv = element("bufferViews", bv_index, name);
-    const std::uint64_t buffer_index = uint_field(bv, "buffer", -1, bv_name);
-    std::string_view data = buffer(buffer_index);
-    const std::uint64_t bv_offset = uint_field(bv, "byteOffset", 0, bv_name);
-    const std::uint64_t bv_length = uint_field(bv, "byteLength", -1, bv_name);
-    if (bv_offset > data.size() || bv_length > data.size() - bv_offset) {
-      fail(ErrorCode::ParseError, path_ + ": " + bv_name + " lies outside buffer " + std::to_string(buffer_index));
-    }
+    const std::string_view data = buffer_view_bytes(bv_index);
+    const std::uint64_t bv_length = data.size();
     const std::size_t element_size = csize * components;
     // The spec bounds byteStride to [4, 252]; the bound also keeps count * stride small.
     const std::uint64_t stride = uint_field(bv, "byteStride", 0, bv_name);
@@ -371,8 +453,86 @@ class GltfReader {
                       (acc_offset <= bv_length && view.count <= bv_length &&
                        (view.count - 1) * view.stride + element_size <= bv_length - acc_offset);
     if (!fits) fail(ErrorCode::ParseError, path_ + ": " + name + " lies outside " + bv_name);
-    view.data = data.data() + bv_offset + acc_offset;
+    view.data = data.data() + acc_offset;
     return view;
+  }
+
+  /// The bytes of bufferView `index`: a slice of its buffer, or for a meshopt-compressed view
+  /// (EXT_meshopt_compression / KHR_meshopt_compression) its decoded data, decoded once.
+  std::string_view buffer_view_bytes(std::uint64_t index) {
+    const std::string bv_name = "bufferView " + std::to_string(index);
+    const json& bv = element("bufferViews", index, "an accessor");
+    DecodedView& cached = decoded_views_[static_cast<std::size_t>(index)];
+    if (cached.done) return cached.bytes;
+    const std::uint64_t length = uint_field(bv, "byteLength", -1, bv_name);
+    const json* meshopt = nullptr;
+    std::string ext_name;
+    if (auto ext = bv.find("extensions"); ext != bv.end() && ext->is_object()) {
+      for (const char* name : {"KHR_meshopt_compression", "EXT_meshopt_compression"}) {
+        if (auto it = ext->find(name); it != ext->end() && !meshopt) {
+          meshopt = &*it;
+          ext_name = name;
+        }
+      }
+    }
+    if (!meshopt) {
+      const std::uint64_t buffer_index = uint_field(bv, "buffer", -1, bv_name);
+      std::string_view data = buffer(buffer_index);
+      const std::uint64_t offset = uint_field(bv, "byteOffset", 0, bv_name);
+      if (offset > data.size() || length > data.size() - offset) {
+        fail(ErrorCode::ParseError, path_ + ": " + bv_name + " lies outside buffer " + std::to_string(buffer_index));
+      }
+      return data.substr(static_cast<std::size_t>(offset), static_cast<std::size_t>(length));
+    }
+    // The compressed bytes are in the extension's buffer; the view's own buffer is usually a
+    // fallback without data (EXT_meshopt_compression README, "Fallback buffers").
+    const std::string where = bv_name + " " + ext_name;
+    if (!meshopt->is_object()) fail(ErrorCode::ParseError, path_ + ": " + where + " is not an object");
+    const std::uint64_t buffer_index = uint_field(*meshopt, "buffer", -1, where);
+    std::string_view data = buffer(buffer_index);
+    const std::uint64_t offset = uint_field(*meshopt, "byteOffset", 0, where);
+    const std::uint64_t compressed = uint_field(*meshopt, "byteLength", -1, where);
+    if (offset > data.size() || compressed > data.size() - offset) {
+      fail(ErrorCode::ParseError, path_ + ": " + where + " lies outside buffer " + std::to_string(buffer_index));
+    }
+    const std::uint64_t stride = uint_field(*meshopt, "byteStride", -1, where);
+    const std::uint64_t count = uint_field(*meshopt, "count", -1, where);
+    auto text = [&](const char* key, const char* fallback) {
+      auto it = meshopt->find(key);
+      if (it == meshopt->end()) return std::string(fallback);
+      if (!it->is_string()) fail(ErrorCode::ParseError, path_ + ": " + where + ": '" + key + "' is not a string");
+      return it->get<std::string>();
+    };
+    const std::string mode_name = text("mode", "");
+    MeshoptMode mode = MeshoptMode::Attributes;
+    if (mode_name == "TRIANGLES") {
+      mode = MeshoptMode::Triangles;
+    } else if (mode_name == "INDICES") {
+      mode = MeshoptMode::Indices;
+    } else if (mode_name != "ATTRIBUTES") {
+      fail(ErrorCode::ParseError, path_ + ": " + where + " has unknown mode " + quote_token(mode_name));
+    }
+    const std::string filter_name = text("filter", "NONE");
+    MeshoptFilter filter = MeshoptFilter::None;
+    if (filter_name == "OCTAHEDRAL") {
+      filter = MeshoptFilter::Octahedral;
+    } else if (filter_name == "QUATERNION") {
+      filter = MeshoptFilter::Quaternion;
+    } else if (filter_name == "EXPONENTIAL") {
+      filter = MeshoptFilter::Exponential;
+    } else if (filter_name != "NONE") {
+      fail(ErrorCode::Unsupported, path_ + ": " + where + " uses filter " + quote_token(filter_name) + " (not supported)");
+    }
+    Status s = decode_meshopt(data.substr(static_cast<std::size_t>(offset), static_cast<std::size_t>(compressed)), count,
+                              stride, mode, filter, cached.bytes);
+    if (!s.ok()) fail(s.code(), path_ + ": " + where + ": " + s.message());
+    if (cached.bytes.size() < length) {
+      fail(ErrorCode::ParseError, path_ + ": " + where + " decodes to " + std::to_string(cached.bytes.size()) +
+                                      " bytes, byteLength says " + std::to_string(length));
+    }
+    cached.bytes.resize(static_cast<std::size_t>(length));
+    cached.done = true;
+    return cached.bytes;
   }
 
   /// The bytes of buffer `i`, loading external files and data URIs on first use.
@@ -446,6 +606,13 @@ class GltfReader {
   MeshBuilder& builder_;
   PositionWelder welder_;
   std::vector<Buffer> buffers_;
+  // Decoded meshopt bufferViews, one per bufferView (sized once in read(), never grown, so the
+  // views handed out into `bytes` stay valid).
+  struct DecodedView {
+    bool done = false;
+    std::string bytes;
+  };
+  std::vector<DecodedView> decoded_views_;
   std::uint64_t face_count_ = 0;
 };
 

@@ -4,8 +4,10 @@
 //
 // Design note: vertices and triangles go straight into the output Eigen matrices, grown by
 // doubling; Eigen resizes row-major matrices with realloc, so growing (mremap for large
-// blocks) and the final shrink are cheap and nothing is copied at the end. Faces are
-// fan-triangulated as they arrive (no per-polygon storage). Indices are checked against the
+// blocks) and the final shrink are cheap and nothing is copied at the end. Triangles go in as
+// they arrive; polygons reserve their n - 2 rows and keep their corners until finish(), which
+// triangulates them (polygon_triangulation.h) once every vertex position is known (OBJ allows
+// forward references, PLY may list faces before vertices). Indices are checked against the
 // vertex count once the file is fully read, because OBJ allows forward references and PLY
 // may list faces before vertices; only the rare indices that are not yet known to be valid
 // are remembered (with their source position) for that check.
@@ -19,6 +21,7 @@
 #include <vector>
 
 #include "spherekit/formats/mesh_io.h"
+#include "spherekit/formats/polygon_triangulation.h"
 
 namespace spherekit::formats::detail {
 
@@ -60,8 +63,14 @@ class MeshBuilder {
     return {};
   }
 
+  /// Also carry a second index per face corner (OBJ texture-coordinate indices) through the
+  /// triangulation: corner_channel() then gives it per triangle corner.
+  void enable_corner_channel() { channel_enabled_ = true; }
+
   /// Adds a polygon of `n` 0-based corner indices (relative OBJ indices already resolved).
-  Status add_face(const std::int64_t* corners, std::size_t n, FaceSource where) {
+  /// `channel`: n values of the corner channel, or nullptr if this face has none.
+  Status add_face(const std::int64_t* corners, std::size_t n, FaceSource where,
+                  const std::int64_t* channel = nullptr) {
     if (n < 3) {
       return Status(ErrorCode::ParseError, subject(where) + " has " + std::to_string(n) +
                                                (n == 1 ? " corner" : " corners") + " (need at least 3)");
@@ -75,7 +84,7 @@ class MeshBuilder {
       std::size_t lo = std::min(n, first_corner_count_), hi = std::max(n, first_corner_count_);
       return Status(ErrorCode::InvalidInput, prefix(where) + "mixed " + corner_noun(lo) + " and " +
                                                  corner_noun(hi) +
-                                                 " faces (use triangulation to accept polygons)");
+                                                 " faces (PolygonPolicy::Triangulate accepts them)");
     }
     if (nf_ + static_cast<std::int64_t>(n - 2) > kMaxIndex) {
       return Status(ErrorCode::Unsupported, path_ + ": more than 2^31-1 triangles");
@@ -84,21 +93,38 @@ class MeshBuilder {
       // Indices that are not yet known to be valid are checked in finish().
       if (corners[i] < 0 || corners[i] >= num_vertices()) pending_.push_back({corners[i], where});
     }
-    if (n > 3) ++polygons_triangulated_;
-    // Fan triangulation (c0, ci, ci+1): exact for convex polygons, which is what quad and
-    // n-gon meshes meant for parameterization contain; check_mesh reports anything odd.
+    const auto polygon = static_cast<std::int32_t>(counts_.faces);
+    ++counts_.faces;
+    if (n == 3) {
+      ++counts_.triangles;
+    } else if (n == 4) {
+      ++counts_.quads;
+    } else {
+      ++counts_.ngons;
+    }
+    if (channel_enabled_ && !channel) channel_complete_ = false;
+    if (n > 3) {
+      // Rows reserved now, filled by finish(): the corners' positions may not be read yet.
+      polygons_.push_back({nf_, corner_store_.size(), n});
+      corner_store_.insert(corner_store_.end(), corners, corners + n);
+      if (channel_enabled_ && channel) channel_store_.insert(channel_store_.end(), channel, channel + n);
+      if (channel_enabled_ && !channel) channel_store_.resize(channel_store_.size() + n, -1);
+    }
     for (std::size_t i = 1; i + 1 < n; ++i) {
       if (nf_ == F_.rows()) F_.conservativeResize(grown(F_.rows()), 3);
       F_(nf_, 0) = clamp_index(corners[0]);
       F_(nf_, 1) = clamp_index(corners[i]);
       F_(nf_, 2) = clamp_index(corners[i + 1]);
+      face_polygon_.push_back(polygon);
+      if (channel_enabled_) channel_.insert(channel_.end(), {channel ? channel[0] : -1, channel ? channel[i] : -1,
+                                                             channel ? channel[i + 1] : -1});
       ++nf_;
     }
     return {};
   }
 
-  /// Validates everything and returns the mesh. Errors: InvalidInput for no faces, an
-  /// index out of range or a non-finite coordinate.
+  /// Validates everything, triangulates the polygons and returns the mesh. Errors:
+  /// InvalidInput for no faces, an index out of range or a non-finite coordinate.
   Result<TriMesh> finish(ReadInfo& info) {
     const std::int64_t nv = nv_;
     for (const Pending& p : pending_) {
@@ -114,13 +140,23 @@ class MeshBuilder {
         return Status(ErrorCode::InvalidInput, path_ + ": vertex " + std::to_string(i) + " has a non-finite coordinate");
       }
     }
+    triangulate_polygons();
     TriMesh mesh;
     V_.conservativeResize(nv_, 3);
     F_.conservativeResize(nf_, 3);
     mesh.V = std::move(V_);
     mesh.F = std::move(F_);
-    info.polygons_triangulated = polygons_triangulated_;
+    info.polygons_triangulated = static_cast<int>(counts_.quads + counts_.ngons);
+    info.faces = counts_;
+    info.face_polygon = std::move(face_polygon_);
     return mesh;
+  }
+
+  /// After finish(): the corner channel of every triangle corner (3 per triangle, in F's
+  /// order), or empty if it was not enabled or some face had none.
+  std::vector<std::int64_t> corner_channel() {
+    if (!channel_enabled_ || !channel_complete_) return {};
+    return std::move(channel_);
   }
 
  private:
@@ -130,6 +166,34 @@ class MeshBuilder {
     std::int64_t index;
     FaceSource where;
   };
+  struct Polygon {
+    std::int64_t first_triangle;
+    std::size_t first_corner;  // in corner_store_ (and channel_store_)
+    std::size_t corners;
+  };
+
+  /// Replaces the placeholder fan of every polygon by its triangulation (indices are valid now).
+  void triangulate_polygons() {
+    std::vector<Eigen::Vector3d> points;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    for (const Polygon& p : polygons_) {
+      const std::int64_t* c = corner_store_.data() + p.first_corner;
+      points.resize(p.corners);
+      for (std::size_t i = 0; i < p.corners; ++i) points[i] = V_.row(static_cast<Eigen::Index>(c[i])).transpose();
+      triangles.clear();
+      triangulate_polygon(points, triangles);
+      for (std::size_t t = 0; t < triangles.size(); ++t) {
+        const Eigen::Index row = static_cast<Eigen::Index>(p.first_triangle) + static_cast<Eigen::Index>(t);
+        for (int k = 0; k < 3; ++k) {
+          const std::size_t local = triangles[t][static_cast<std::size_t>(k)];
+          F_(row, k) = static_cast<std::int32_t>(c[local]);
+          if (channel_enabled_ && channel_complete_)
+            channel_[3 * static_cast<std::size_t>(row) + static_cast<std::size_t>(k)] =
+                channel_store_[p.first_corner + local];
+        }
+      }
+    }
+  }
 
   static Eigen::Index grown(Eigen::Index rows) {
     return std::min<Eigen::Index>(kMaxIndex, std::max<Eigen::Index>(64, 2 * rows));
@@ -159,7 +223,12 @@ class MeshBuilder {
   std::int64_t nv_ = 0, nf_ = 0;
   std::vector<Pending> pending_;
   std::size_t first_corner_count_ = 0;
-  int polygons_triangulated_ = 0;
+  FaceCounts counts_;
+  std::vector<std::int32_t> face_polygon_;
+  std::vector<Polygon> polygons_;
+  std::vector<std::int64_t> corner_store_;
+  bool channel_enabled_ = false, channel_complete_ = true;
+  std::vector<std::int64_t> channel_, channel_store_;
 };
 
 }  // namespace spherekit::formats::detail

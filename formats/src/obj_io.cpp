@@ -31,16 +31,17 @@ Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const 
     return Status(ErrorCode::ParseError, path + ": not a text file (NUL byte at offset " + std::to_string(nul) + ")");
   }
   MeshBuilder builder(path, options.polygons, /*index_base=*/1);
+  if (attributes) builder.enable_corner_channel();
   // A typical OBJ spends ~30 bytes per vertex line and ~2 face lines per vertex; this avoids
   // most regrowth without trusting anything the file claims.
   builder.reserve(bytes.size() / 80, bytes.size() / 40);
   LineReader lines(bytes);
   std::vector<std::int64_t> corners;
   // Attributes (only collected when asked for): colours per vertex, texture coordinates,
-  // the texture index of every triangle corner (fanned like the faces), and whether some
-  // corner had none (then FT is not set).
+  // the texture index of every face corner (the builder triangulates them with the faces),
+  // and whether some corner had none (then FT is not set).
   std::vector<double> colors, uv;
-  std::vector<std::int64_t> tex_corners, fan;
+  std::vector<std::int64_t> tex;
   std::int64_t colored_vertices = 0;
   bool corner_without_uv = false;
   std::string_view line, token;
@@ -91,7 +92,7 @@ Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const 
       if (attributes->material.empty() && next_token(rest, token)) attributes->material = std::string(token);
     } else if (token == "f") {
       corners.clear();
-      fan.clear();
+      tex.clear();
       while (next_token(rest, token) && token.front() != '#') {
         std::string_view index_text = token.substr(0, token.find('/'));
         std::int64_t index = 0;
@@ -117,19 +118,18 @@ Result<TriMesh> read_obj(const std::string& path, std::string_view bytes, const 
             return Status(ErrorCode::ParseError, at_line(path, lines.number()) + "bad texture index in corner " +
                                                      quote_token(token));
           } else {
-            fan.push_back(ti > 0 ? ti - 1 : nt + ti);
+            tex.push_back(ti > 0 ? ti - 1 : nt + ti);
           }
         }
       }
-      // The same fan (c0, ci, ci+1) as MeshBuilder::add_face.
-      if (attributes && fan.size() == corners.size()) {
-        for (std::size_t i = 1; i + 1 < fan.size(); ++i) tex_corners.insert(tex_corners.end(), {fan[0], fan[i], fan[i + 1]});
-      }
-      SPHEREKIT_RETURN_IF_ERROR(builder.add_face(corners.data(), corners.size(), FaceSource::line(lines.number())));
+      const bool has_tex = attributes && tex.size() == corners.size();
+      SPHEREKIT_RETURN_IF_ERROR(builder.add_face(corners.data(), corners.size(), FaceSource::line(lines.number()),
+                                                 has_tex ? tex.data() : nullptr));
     }
   }
   SPHEREKIT_ASSIGN_OR_RETURN(TriMesh mesh, builder.finish(info));
   if (attributes) {
+    const std::vector<std::int64_t> tex_corners = builder.corner_channel();
     if (colored_vertices > 0 && colored_vertices != mesh.V.rows())
       return Status(ErrorCode::ParseError, path + ": " + std::to_string(colored_vertices) + " of " +
                                                std::to_string(mesh.V.rows()) + " vertices have colours (all or none)");

@@ -384,7 +384,8 @@ std::string first_problem(const MeshCheck& c, bool allow_boundary) {
   if (c.unreferenced_vertices > 0)
     return "vertex " + s(c.first_unreferenced_vertex) + " is used by no face (" +
            plural(c.unreferenced_vertices, "unreferenced vertex", "unreferenced vertices") +
-           "); remove unreferenced vertices, a sphere map needs every vertex on the surface";
+           "); a sphere map needs every vertex on the surface: drop them with `spherekit check MESH --repair -o "
+           "OUT` (vertex numbers change: remap landmark files)";
   if (!c.orientable) return "mesh is not orientable (like a Moebius strip); no consistent face orientation exists";
   if (c.orientation_conflicts > 0)
     return "faces are inconsistently oriented (" + plural(c.orientation_conflicts, "edge", "edges") +

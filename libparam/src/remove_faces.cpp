@@ -2,6 +2,8 @@
 
 #include <numeric>
 
+#include "spherekit/check_mesh.h"
+
 namespace spherekit {
 
 TriMesh remove_faces(const TriMesh& mesh, const std::vector<std::uint8_t>& drop, std::vector<int>* new_index) {
@@ -37,6 +39,15 @@ TriMesh remove_faces(const TriMesh& mesh, const std::vector<std::uint8_t>& drop,
   }
   if (new_index) *new_index = std::move(index);
   return out;
+}
+
+int remove_unreferenced_vertices(TriMesh& mesh, std::vector<int>* old_to_new) {
+  std::vector<int> index;
+  TriMesh kept = remove_faces(mesh, std::vector<std::uint8_t>(static_cast<std::size_t>(mesh.F.rows()), 0), &index);
+  const int dropped = static_cast<int>(mesh.V.rows() - kept.V.rows());
+  mesh = std::move(kept);
+  if (old_to_new) *old_to_new = std::move(index);
+  return dropped;
 }
 
 }  // namespace spherekit

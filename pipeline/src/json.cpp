@@ -15,6 +15,15 @@ std::uintmax_t file_bytes(const std::string& path) {
   return ec ? 0 : n;
 }
 
+Json source_faces_json(const formats::ReadInfo& info) {
+  Json j{{"faces", info.faces.faces},
+         {"triangles", info.faces.triangles},
+         {"quads", info.faces.quads},
+         {"ngons", info.faces.ngons}};
+  if (info.polygons_triangulated > 0) j["face_polygon"] = info.face_polygon;
+  return j;
+}
+
 Json mesh_check_json(const std::string& file, const MeshCheck& c) {
   Json j;
   j["file"] = file;

@@ -35,6 +35,17 @@ Result<LoadedMesh> load_mesh_checked(const std::string& path, bool allow_boundar
   return loaded;
 }
 
+MeshRepair repair_mesh(LoadedMesh& m) {
+  Stopwatch t;
+  MeshRepair r;
+  r.removed_unreferenced_vertices = remove_unreferenced_vertices(m.mesh);
+  r.split_vertices = repair_pinched_vertices(m.mesh);
+  m.split_vertices += r.split_vertices;
+  m.check = check_mesh(m.mesh);
+  m.check_seconds += t.seconds();
+  return r;
+}
+
 Status param_verdict(const LoadedMesh& m, bool allow_boundary) {
   return with_file(require_param_accepts(m.mesh, m.check, allow_boundary), m.path);
 }

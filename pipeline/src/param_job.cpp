@@ -118,6 +118,7 @@ Json to_json(const ParamResult& p) {
     j["targets"] = a.targets;
     j["V"] = m.check.vertices;
     j["F"] = m.check.faces;
+    j["source_faces"] = source_faces_json(m.info);
     j["method"] = "constrained";
     const Json measures = constrained_measures_json(r);  // named: items() does not extend its lifetime
     for (const auto& [key, value] : measures.items()) j[key] = value;
@@ -136,6 +137,7 @@ Json to_json(const ParamResult& p) {
   const SphereParamResult& r = *p.unconstrained;
   j["V"] = m.check.vertices;
   j["F"] = m.check.faces;
+  j["source_faces"] = source_faces_json(m.info);
   const Json measures = sphere_param_result_json(r);  // named: items() does not extend its lifetime
   for (const auto& [key, value] : measures.items()) j[key] = value;
   j["times"]["read"] = m.read_seconds;

@@ -8,10 +8,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "cli_runner.h"
+#include "compressed_glb.h"
+#include "test_meshes.h"
 #include "test_paths.h"
 #include "test_files.h"
 #include "cli_shorthands.h"
@@ -70,10 +74,10 @@ struct MeshCase {
   const char* problem;  // a phrase the message must contain
 };
 
-/// check, param and convert on a bad mesh: same exit code, same one-line message, no output.
-void run_mesh_case(const MeshCase& c, const std::string& dir) {
-  const std::string mesh = bad(c.file);
-  INFO("case: " << c.file);
+/// check, param and convert on a bad mesh file: same exit code, same one-line message, no output.
+void run_mesh_file(const std::string& mesh, int exit_code, const std::string& problem, const std::string& dir) {
+  const MeshCase c{mesh.c_str(), exit_code, problem.c_str()};
+  INFO("case: " << mesh);
   const OutputDir out(dir);
 
   require_failure(run_cli("check " + quote(mesh), dir), c.exit_code, mesh, c.problem);
@@ -98,6 +102,9 @@ void run_mesh_case(const MeshCase& c, const std::string& dir) {
                   c.exit_code, mesh, c.problem);
   out.require_untouched();
 }
+
+/// run_mesh_file on a corpus file.
+void run_mesh_case(const MeshCase& c, const std::string& dir) { run_mesh_file(bad(c.file), c.exit_code, c.problem, dir); }
 
 }  // namespace
 
@@ -141,7 +148,6 @@ TEST_CASE("bad input: malformed mesh files", "[cli]") {
       {"obj_bad_number.obj", 3, ":2: bad number 'x'"},
       {"obj_binary_garbage.obj", 3, "not a text file (NUL byte"},
       {"no_faces.obj", 3, "no faces"},
-      {"mixed_polygons.obj", 3, "mixed triangle and 4-corner faces"},
       {"unsupported_extension.xyz", 3, "unsupported mesh format '.xyz'"},
       // PLY
       {"empty.ply", 3, "file is empty"},
@@ -434,4 +440,92 @@ TEST_CASE("bad input: large generated files fail fast", "[cli]") {
   write_text(big_ply, ply);
   require_failure(run_cli("check " + quote(big_ply), dir), 3, big_ply,
                   "binary PLY ends after " + std::to_string(n) + " of " + std::to_string(n + 1) + " vertices");
+}
+
+TEST_CASE("bad input: corrupt compressed glTF", "[cli]") {
+  // Generated here from good files: a Draco .glb as `convert --lods` writes it, and a meshopt
+  // .glb as gltfpack writes it (compressed_glb.h). Both good ones are read.
+  const std::string dir = spherekit::test::temp_dir("bad_input_compressed_gltf");
+  const std::string oct = dir + "/oct.exr";
+  const CliRun made = run_cli("convert " + quote(bad("octahedron.obj")) + " " + quote(bad("octahedron.sphere.obj")) +
+                                  " -o " + quote(oct) + " --size 17 --lods 1 --psnr-samples 100 --quiet",
+                              dir);
+  INFO("stderr: " << made.err);
+  REQUIRE(made.exit_code == 0);
+  const std::string draco_glb = dir + "/oct_lod0.glb";
+  REQUIRE(fs::exists(draco_glb));
+  const std::string meshopt_glb = dir + "/blob_meshopt.glb";
+  write_text(meshopt_glb, spherekit::test::meshopt_glb(spherekit::test::random_blob(2, 5),
+                                                       spherekit::test::MeshoptGlb::QuantizedTriangles));
+  for (const std::string& good : {draco_glb, meshopt_glb}) {
+    const CliRun c = run_cli("check " + quote(good), dir);
+    INFO("stderr: " << c.err);
+    CHECK(c.exit_code == 0);
+  }
+
+  const spherekit::test::GlbParts draco = spherekit::test::glb_parts(slurp(draco_glb));
+  const spherekit::test::GlbParts meshopt = spherekit::test::glb_parts(slurp(meshopt_glb));
+  const nlohmann::json& prim = draco.json["meshes"][0]["primitives"][0];
+  const int view = prim["extensions"]["KHR_draco_mesh_compression"]["bufferView"].get<int>();
+  const std::string ext = "EXT_meshopt_compression";
+  struct Case {
+    std::string file;
+    const spherekit::test::GlbParts* from;
+    std::function<void(spherekit::test::GlbParts&)> spoil;
+    std::string problem;
+  };
+  const std::vector<Case> cases = {
+      {"draco_truncated.glb", &draco,
+       [&](spherekit::test::GlbParts& g) {
+         auto& bv = g.json["bufferViews"][view];
+         bv["byteLength"] = bv["byteLength"].get<std::size_t>() / 2;
+       },
+       "KHR_draco_mesh_compression (bufferView " + std::to_string(view) + "): Draco data is corrupt or truncated"},
+      {"draco_wrong_count.glb", &draco,
+       [&](spherekit::test::GlbParts& g) {
+         const int acc = prim["attributes"]["POSITION"].get<int>();
+         g.json["accessors"][acc]["count"] = g.json["accessors"][acc]["count"].get<int>() + 1;
+       },
+       "POSITION accessor count"},
+      {"meshopt_bad_header.glb", &meshopt,
+       [&](spherekit::test::GlbParts& g) {
+         g.bin[g.json["bufferViews"][0]["extensions"][ext]["byteOffset"].get<std::size_t>()] = 0x13;
+       },
+       "bufferView 0 EXT_meshopt_compression: meshopt data is corrupt"},
+      {"meshopt_wrong_count.glb", &meshopt,
+       [&](spherekit::test::GlbParts& g) { g.json["bufferViews"][0]["extensions"][ext]["count"] = 4000000000ull; }, 
+       "cannot come from"},
+  };
+  for (const Case& c : cases) {
+    spherekit::test::GlbParts g = *c.from;
+    c.spoil(g);
+    const std::string path = dir + "/" + c.file;
+    write_text(path, spherekit::test::glb_bytes(g));
+    run_mesh_file(path, 3, c.problem, dir);
+  }
+}
+
+TEST_CASE("bad input: unreferenced vertices are refused with a hint and dropped by check --repair", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("bad_input_unreferenced");
+  const std::string mesh = bad("duplicate_vertex_unreferenced.obj");
+  require_failure(run_cli("check " + quote(mesh), dir), 3, mesh, "--repair -o OUT");
+  const OutputDir out(dir);
+  const CliRun r = run_cli("check --json " + quote(mesh) + " --repair -o " + quote(out.path("fixed.obj")), dir);
+  INFO("stderr: " << r.err);
+  CHECK(r.exit_code == 0);  // the repaired mesh is accepted
+  CHECK(r.out.find("\"removed_unreferenced_vertices\": 1") != std::string::npos);
+  CHECK(r.out.find("\"unreferenced_vertices\": 0") != std::string::npos);
+  const CliRun text = run_cli("check " + quote(mesh) + " --repair -o " + quote(out.path("fixed2.obj")), dir);
+  CHECK(text.out.find("removed 1 unreferenced vertex") != std::string::npos);
+  CHECK(text.out.find("landmark files of the input need remapping") != std::string::npos);
+  const CliRun again = run_cli("check " + quote(out.path("fixed.obj")), dir);
+  CHECK(again.exit_code == 0);
+  CHECK(again.out.find("7 vertices") == std::string::npos);
+  CHECK(again.out.find("6 vertices") != std::string::npos);
+  const std::string sphere = out.path("fixed.sphere.obj");
+  const CliRun p = run_cli("param " + quote(out.path("fixed.obj")) + " -o " + quote(sphere) + " --quiet", dir);
+  INFO("stderr: " << p.err);
+  CHECK(p.exit_code == 0);
+  const CliRun e = run_cli("eval --json " + quote(out.path("fixed.obj")) + " " + quote(sphere), dir);
+  CHECK(e.out.find("\"flipped_exact\":0") != std::string::npos);
 }

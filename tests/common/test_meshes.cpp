@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <sstream>
 #include <vector>
 
 namespace spherekit::test {
@@ -166,6 +167,53 @@ TriMesh elongated(int level, double aspect) {
   TriMesh m = icosphere(level);
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) m.V(i, 0) *= aspect;
   return m;
+}
+
+PolygonMesh star_prism_polygons() {
+  constexpr int kCorners = 12;
+  constexpr double kPi = 3.14159265358979323846;
+  PolygonMesh m;
+  m.V.resize(2 * kCorners + 2, 3);
+  // Rings: b_i = i, t_i = kCorners + i; the top ring is turned by 10 degrees (non-planar sides).
+  for (int ring = 0; ring < 2; ++ring) {
+    for (int i = 0; i < kCorners; ++i) {
+      const double r = i % 2 == 0 ? 1.0 : 0.45;
+      const double a = 2 * kPi * i / kCorners + (ring == 1 ? 10.0 * kPi / 180 : 0.0);
+      m.V.row(ring * kCorners + i) << r * std::cos(a), r * std::sin(a), ring;
+    }
+  }
+  const int mid = 2 * kCorners, apex = 2 * kCorners + 1;
+  m.V.row(mid) = 0.5 * (m.V.row(kCorners) + m.V.row(kCorners + 1));  // on the edge t0-t1
+  m.V.row(apex) << 0, 0, 1.6;
+  auto b = [](int i) { return i % kCorners; };
+  auto t = [](int i) { return kCorners + i % kCorners; };
+  std::vector<int> base;
+  for (int i = kCorners - 1; i >= 0; --i) base.push_back(b(i));  // seen from below
+  m.faces.push_back(base);
+  m.faces.push_back({b(0), b(1), t(1), mid, t(0)});  // the pentagon
+  for (int i = 1; i < kCorners; ++i) m.faces.push_back({b(i), b(i + 1), t(i + 1), t(i)});
+  m.faces.push_back({t(0), mid, t(1), apex});
+  for (int i = 1; i < kCorners; ++i) m.faces.push_back({t(i), t(i + 1), apex});
+  return m;
+}
+
+std::string polygon_mesh_text(const PolygonMesh& mesh, const std::string& format) {
+  std::ostringstream out;
+  out.precision(17);
+  const auto nv = mesh.V.rows();
+  if (format == "off") out << "OFF\n" << nv << " " << mesh.faces.size() << " 0\n";
+  if (format == "ply")
+    out << "ply\nformat ascii 1.0\nelement vertex " << nv << "\nproperty double x\nproperty double y\n"
+        << "property double z\nelement face " << mesh.faces.size() << "\nproperty list uchar int vertex_indices\n"
+        << "end_header\n";
+  for (Eigen::Index v = 0; v < nv; ++v)
+    out << (format == "obj" ? "v " : "") << mesh.V(v, 0) << " " << mesh.V(v, 1) << " " << mesh.V(v, 2) << "\n";
+  for (const std::vector<int>& f : mesh.faces) {
+    out << (format == "obj" ? "f" : std::to_string(f.size()));
+    for (const int c : f) out << " " << (format == "obj" ? c + 1 : c);
+    out << "\n";
+  }
+  return out.str();
 }
 
 }  // namespace spherekit::test

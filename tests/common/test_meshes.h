@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "spherekit/mesh.h"
 
@@ -26,5 +28,18 @@ TriMesh sphere_with_holes(int level, int holes);
 TriMesh random_blob(int level, std::uint64_t seed);
 /// A long thin shape (capsule stretched `aspect` times along x): hard for stretch.
 TriMesh elongated(int level, double aspect);
+
+/// A mesh with polygon faces, as a DCC tool exports it.
+struct PolygonMesh {
+  RowMat3d V;
+  std::vector<std::vector<int>> faces;  ///< 0-based corners, counter-clockwise seen from outside
+};
+/// A closed genus-0 "star prism" mixing every face kind: a non-convex 12-corner star base
+/// (an n-gon a fan would fold), 11 twisted (non-planar) side quads, one side pentagon, a cap of
+/// 11 triangles (a fan around an apex) and one cap quad. 26 vertices; 11 triangles, 12 quads,
+/// 2 n-gons (25 faces, 48 triangles after triangulation).
+PolygonMesh star_prism_polygons();
+/// The file text of `mesh` as "obj", "off" or "ply" (ascii).
+std::string polygon_mesh_text(const PolygonMesh& mesh, const std::string& format);
 
 }  // namespace spherekit::test

@@ -281,8 +281,8 @@ TEST_CASE("require_genus0 names the first blocking problem", "[param][check]") {
     CHECK(c.bbox_diag == Approx(2.0));  // unreferenced vertices do not count
     CHECK(c.genus == 0);
     CHECK(refusal(m) ==
-          "vertex 4 is used by no face (1 unreferenced vertex); remove unreferenced vertices, a sphere map needs "
-          "every vertex on the surface");
+          "vertex 4 is used by no face (1 unreferenced vertex); a sphere map needs every vertex on the surface: drop "
+          "them with `spherekit check MESH --repair -o OUT` (vertex numbers change: remap landmark files)");
   }
   SECTION("one face flipped") {
     TriMesh m = test::icosphere(1);
@@ -406,4 +406,51 @@ TEST_CASE("require_param_accepts: one verdict for the stages and the command lin
   TriMesh torus = test::torus();
   torus.V *= 1e300;
   CHECK(require_param_accepts(torus, check_mesh(torus)).message() == require_genus0(check_mesh(torus)).message());
+}
+
+TEST_CASE("remove_unreferenced_vertices drops unused vertices and renumbers faces", "[param]") {
+  // An icosphere with unused vertices put before, between and after the used ones.
+  const TriMesh sphere = test::icosphere(1);
+  const int nv = static_cast<int>(sphere.V.rows());
+  TriMesh m;
+  m.V.resize(nv + 3, 3);
+  std::vector<int> placed(static_cast<std::size_t>(nv));
+  int row = 0;
+  m.V.row(row++) << 9, 9, 9;  // unused, first
+  for (int v = 0; v < nv; ++v) {
+    if (v == nv / 2) m.V.row(row++) << -9, 9, 9;  // unused, in the middle
+    placed[static_cast<std::size_t>(v)] = row;
+    m.V.row(row++) = sphere.V.row(v);
+  }
+  m.V.row(row++) << 9, -9, 9;  // unused, last
+  m.F = sphere.F;
+  for (Eigen::Index i = 0; i < m.F.size(); ++i) m.F.data()[i] = placed[static_cast<std::size_t>(m.F.data()[i])];
+  REQUIRE(check_mesh(m).unreferenced_vertices == 3);
+  CHECK(!require_genus0(check_mesh(m)).ok());
+
+  std::vector<int> old_to_new;
+  CHECK(remove_unreferenced_vertices(m, &old_to_new) == 3);
+  CHECK(m.V == sphere.V);  // order kept
+  CHECK(m.F == sphere.F);
+  REQUIRE(old_to_new.size() == static_cast<std::size_t>(nv + 3));
+  CHECK(old_to_new.front() == -1);
+  CHECK(old_to_new.back() == -1);
+  CHECK(old_to_new[static_cast<std::size_t>(nv / 2 + 1)] == -1);
+  for (int v = 0; v < nv; ++v) CHECK(old_to_new[static_cast<std::size_t>(placed[static_cast<std::size_t>(v)])] == v);
+  CHECK(require_genus0(check_mesh(m)).ok());
+
+  // Nothing to drop: unchanged, identity map.
+  CHECK(remove_unreferenced_vertices(m, &old_to_new) == 0);
+  CHECK(m.V == sphere.V);
+  CHECK(old_to_new[5] == 5);
+
+  // An index out of range: left alone.
+  TriMesh bad = m;
+  bad.V.conservativeResize(nv + 1, 3);
+  bad.V.row(nv) << 1, 2, 3;
+  bad.F(0, 0) = nv + 7;
+  const TriMesh before = bad;
+  CHECK(remove_unreferenced_vertices(bad) == 0);
+  CHECK(bad.V == before.V);
+  CHECK(bad.F == before.F);
 }

@@ -39,6 +39,7 @@ using pipeline::constrained_options_json;
 using pipeline::feature_network_json;
 using pipeline::file_bytes;
 using pipeline::mesh_check_json;
+using pipeline::source_faces_json;
 using pipeline::number_or_null;
 using pipeline::require_output_folders;
 using pipeline::sphere_map_metrics_json;

@@ -1,5 +1,5 @@
 // `spherekit check`: the structural report of meshes (check_mesh) and the verdict the
-// parameterizer would give (require_genus0); optionally splits pinched vertices.
+// parameterizer would give (require_param_accepts); --repair is pipeline::repair_mesh.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
@@ -23,8 +23,12 @@ struct CheckArgs {
   std::string landmarks;
 };
 
-void print_human(const std::string& path, const MeshCheck& c, const Status& verdict) {
+void print_human(const std::string& path, const MeshCheck& c, const formats::ReadInfo& info, const Status& verdict) {
   std::printf("%s: %d vertices, %d faces, %d edges\n", path.c_str(), c.vertices, c.faces, c.edges);
+  if (info.polygons_triangulated > 0)
+    std::printf("  file faces %lld: %lld triangles, %lld quads, %lld n-gons (polygons triangulated)\n",
+                static_cast<long long>(info.faces.faces), static_cast<long long>(info.faces.triangles),
+                static_cast<long long>(info.faces.quads), static_cast<long long>(info.faces.ngons));
   std::printf("  components %d, boundary loops %d, Euler %d, genus %d, orientable %s\n", c.components,
               c.boundary_loops, c.euler, c.genus, c.orientable ? "yes" : "no");
   std::printf("  non-manifold edges %d, non-manifold vertices %d, orientation conflicts %d\n", c.nonmanifold_edges,
@@ -65,11 +69,9 @@ int run_check(const CheckArgs& args) {
     Result<std::vector<Landmark>> landmarks = std::vector<Landmark>{};
     if (!args.landmarks.empty()) landmarks = formats::read_landmarks(args.landmarks, m.check.vertices);
 
-    int split = 0;
+    pipeline::MeshRepair repair;
     if (args.repair) {
-      // Splitting is the only repair: anything else would change the surface silently.
-      split = repair_pinched_vertices(m.mesh);
-      m.check = check_mesh(m.mesh);
+      repair = pipeline::repair_mesh(m);
       Status written = formats::write_mesh(args.output, m.mesh);
       if (!written.ok()) return print_error(written);
     }
@@ -79,8 +81,12 @@ int run_check(const CheckArgs& args) {
 
     if (args.json) {
       Json j = mesh_check_json(path, m.check);
+      j["source_faces"] = source_faces_json(m.info);
       if (!verdict.ok()) j["error"] = verdict.message();
-      if (args.repair) j["repair"] = Json{{"split_vertices", split}, {"output", args.output}};
+      if (args.repair)
+        j["repair"] = Json{{"split_vertices", repair.split_vertices},
+                           {"removed_unreferenced_vertices", repair.removed_unreferenced_vertices},
+                           {"output", args.output}};
       if (!args.landmarks.empty()) {
         if (landmarks.ok())
           j["landmarks"] = Json{{"file", args.landmarks}, {"count", landmarks->size()}};
@@ -89,10 +95,12 @@ int run_check(const CheckArgs& args) {
       }
       report.push_back(std::move(j));
     } else {
-      print_human(path, m.check, verdict);
+      print_human(path, m.check, m.info, verdict);
       if (args.repair)
-        std::printf("  repair: split %d pinched vertex fan%s; wrote %s\n", split, split == 1 ? "" : "s",
-                    args.output.c_str());
+        std::printf("  repair: removed %d unreferenced vert%s, split %d pinched vertex fan%s; wrote %s%s\n", repair.removed_unreferenced_vertices,
+                    repair.removed_unreferenced_vertices == 1 ? "ex" : "ices", repair.split_vertices,
+                    repair.split_vertices == 1 ? "" : "s", args.output.c_str(),
+                    repair.removed_unreferenced_vertices > 0 ? " (vertex numbers changed: landmark files of the input need remapping)" : "");
       if (!args.landmarks.empty() && landmarks.ok())
         std::printf("  landmarks: %zu in %s, all valid\n", landmarks->size(), args.landmarks.c_str());
     }
@@ -114,16 +122,19 @@ void register_check(CLI::App& app) {
       "non-finite coordinates, Euler characteristic and genus, and whether `param` accepts the mesh\n"
       "(one manifold, oriented, genus-0 component; holes allowed). Exit code: 0 if every mesh is\n"
       "accepted, 3 if a mesh is malformed or not accepted, 4 if a file cannot be read (the worst\n"
-      "over all files). --repair splits pinched vertices (one copy per face fan) and writes the\n"
-      "result to -o, whatever the verdict. --landmarks also validates a landmark file against the\n"
-      "mesh (lines 'name vertex_index': indices in range, names and vertices unique).",
+      "over all files). --repair drops vertices no face uses and splits pinched vertices (one copy per\n"
+      "face fan) and writes the result to -o, whatever the verdict (dropping renumbers the vertices:\n"
+      "landmark files of the input no longer fit). Polygon faces are triangulated on reading; the\n"
+      "report counts the file's triangles, quads and n-gons (--json: face_polygon, triangle -> face).\n"
+      "--landmarks also validates a landmark file against the mesh (lines 'name vertex_index':\n"
+      "indices in range, names and vertices unique).",
       "  spherekit check spot.obj bunny.obj\n"
       "  spherekit check --json meshes/*.obj > checks.json\n"
       "  spherekit check cow.obj --repair -o cow_fixed.obj\n"
       "  spherekit check cat.obj --landmarks cat.lm.txt");
   cmd->add_option("MESH", args->meshes, "mesh files (.obj .ply .off .stl .gltf .glb)")->required();
   cmd->add_flag("--json", args->json, "print a JSON array with one object per mesh instead of text");
-  CLI::Option* repair = cmd->add_flag("--repair", args->repair, "split non-manifold (pinched) vertices; needs -o");
+  CLI::Option* repair = cmd->add_flag("--repair", args->repair, "drop unreferenced vertices and split non-manifold (pinched) ones; needs -o");
   CLI::Option* output = cmd->add_option("-o,--output", args->output, "where --repair writes the repaired mesh (.obj/.ply)");
   repair->needs(output);
   output->needs(repair);

@@ -50,6 +50,14 @@ inline void fuzz_mesh(const std::string& path, const std::uint8_t* data, std::si
   for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) require(m.F(f, k) >= 0 && m.F(f, k) < m.V.rows());
   }
+  // Every triangle names its source face; sources are non-decreasing and each face of n
+  // corners gives n - 2 triangles, so the counts add up.
+  require(info.face_polygon.size() == static_cast<std::size_t>(m.F.rows()));
+  for (std::size_t t = 0; t < info.face_polygon.size(); ++t) {
+    require(info.face_polygon[t] >= 0 && info.face_polygon[t] < info.faces.faces);
+    require(t == 0 || info.face_polygon[t] >= info.face_polygon[t - 1]);
+  }
+  require(info.faces.faces == info.faces.triangles + info.faces.quads + info.faces.ngons);
   for (const char* ext : {"obj", "ply"}) {
     const std::string copy = std::string("round_trip.") + ext;
     const std::string text =

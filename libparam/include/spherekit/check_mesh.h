@@ -136,4 +136,13 @@ Status require_param_accepts(const TriMesh& mesh, const MeshCheck& check, bool a
 /// first; the return value equals its size (the number of appended vertices).
 int repair_pinched_vertices(TriMesh& mesh, std::vector<int>* new_to_old = nullptr);
 
+/// Drops the vertices no face uses (MeshCheck::unreferenced_vertices), keeping the order of the
+/// others; faces keep their order and are renumbered. Returns the number dropped. `old_to_new`
+/// (if given) receives, per vertex of the mesh as passed, its new index or -1 if it was dropped:
+/// anything indexing the old vertices (landmark files) must be remapped through it. A mesh
+/// with a face index outside [0, #V) is left unchanged (returns 0, identity map).
+/// O(V + F). Dropping them loses nothing of the surface: a vertex no face uses has no place on
+/// it (which is why require_genus0 refuses them).
+int remove_unreferenced_vertices(TriMesh& mesh, std::vector<int>* old_to_new = nullptr);
+
 }  // namespace spherekit

@@ -3,6 +3,7 @@
 // write .obj .ply. Every error message names the file and the problem in one line.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -11,22 +12,36 @@
 
 namespace spherekit::formats {
 
-/// What to do with faces of more than three corners.
+/// What to do with faces of more than three corners. Polygons are triangulated by
+/// triangulate_polygon (polygon_triangulation.h: quads along the diagonal that keeps both
+/// triangles unfolded, larger polygons by ear clipping in their best-fit plane; no fans).
 enum class PolygonPolicy {
-  TriangulateUniform,  ///< default: fan-triangulate when all faces have the same corner count
-                       ///< (pure quad meshes...); refuse a mix of triangles and polygons
-  Triangulate,         ///< always fan-triangulate polygons
+  Triangulate,         ///< default: triangulate every polygon (triangles, quads and n-gons may mix)
+  TriangulateUniform,  ///< triangulate only when all faces have the same corner count; refuse a mix
   Reject,              ///< refuse any face with more than three corners
 };
 
 struct ReadOptions {
-  PolygonPolicy polygons = PolygonPolicy::TriangulateUniform;
+  PolygonPolicy polygons = PolygonPolicy::Triangulate;
+};
+
+/// The faces of the file by corner count, before triangulation.
+struct FaceCounts {
+  std::int64_t faces = 0;      ///< faces (polygons) in the file
+  std::int64_t triangles = 0;  ///< faces with 3 corners
+  std::int64_t quads = 0;      ///< faces with 4 corners
+  std::int64_t ngons = 0;      ///< faces with 5 or more corners
 };
 
 /// Extra information about what the reader saw.
 struct ReadInfo {
   std::string format;        ///< "obj", "ply-ascii", "ply-binary-le", "off", "stl-binary", "glb", ...
-  int polygons_triangulated = 0;
+  int polygons_triangulated = 0;  ///< faces.quads + faces.ngons
+  FaceCounts faces;
+  /// For every triangle of the mesh (row of F), the 0-based number of the file's face it was
+  /// cut from, in the order of the file (glTF: of its triangles, in the order read; STL: the
+  /// identity). Non-decreasing; its size is F's row count.
+  std::vector<std::int32_t> face_polygon;
 };
 
 /// Reads a triangle mesh. Errors: IoError (cannot open), ParseError (malformed, truncated,

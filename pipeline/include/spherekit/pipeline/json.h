@@ -8,6 +8,7 @@
 
 #include "spherekit/check_mesh.h"
 #include "spherekit/constrained_param.h"
+#include "spherekit/formats/mesh_io.h"
 #include "spherekit/metrics.h"
 #include "spherekit/sphere_param.h"
 
@@ -23,6 +24,10 @@ std::uintmax_t file_bytes(const std::string& path);
 
 /// The `check` report of a mesh (key names as in shared/meshes/manifest.json).
 Json mesh_check_json(const std::string& file, const MeshCheck& check);
+/// The file's faces before triangulation (formats::ReadInfo): counts by corner count and,
+/// when some polygon was triangulated, `face_polygon` (per triangle of the mesh, the 0-based
+/// face of the file it was cut from; absent means the identity). check --json and param's report.
+Json source_faces_json(const formats::ReadInfo& info);
 /// The options as recorded in reports.
 Json sphere_param_options_json(const SphereParamOptions& options);
 /// The constrained options as recorded in reports (the sphere options plus the network's).

@@ -25,6 +25,17 @@ struct LoadedMesh {
 /// with the file path.
 Result<LoadedMesh> load_mesh(const std::string& path);
 
+/// What repair_mesh did.
+struct MeshRepair {
+  int removed_unreferenced_vertices = 0;  ///< remove_unreferenced_vertices
+  int split_vertices = 0;                 ///< copies added by repair_pinched_vertices
+};
+
+/// `check --repair`: drops vertices no face uses and splits pinched ones, the only repairs
+/// that leave the surface as it is (anything else would change it silently), then checks the
+/// mesh again. Dropping renumbers the vertices after a dropped one.
+MeshRepair repair_mesh(LoadedMesh& mesh);
+
 /// What `param` accepts: the library's one verdict (require_param_accepts, check_mesh.h) with
 /// the message starting with the file path.
 Status param_verdict(const LoadedMesh& mesh, bool allow_boundary);

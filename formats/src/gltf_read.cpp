@@ -78,8 +78,8 @@ struct AccessorView {
 };
 
 /// Component `k` of element `i` as a number: integers as they are, or mapped to [0, 1] /
-/// [-1, 1] when normalized (glTF 2.0, 3.11 "Animations" table of normalized conversions:
-/// c / (2^n - 1) unsigned, max(c / (2^(n-1) - 1), -1) signed).
+/// [-1, 1] when normalized (glTF 2.0's conversion for `accessor.normalized`: c / (2^n - 1)
+/// unsigned, max(c / (2^(n-1) - 1), -1) signed).
 double read_component(const AccessorView& a, std::uint64_t i, int k) {
   const char* p = a.data + i * a.stride + static_cast<std::size_t>(k) * component_size(a.component_type);
   switch (a.component_type) {

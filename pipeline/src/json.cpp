@@ -24,6 +24,13 @@ Json source_faces_json(const formats::ReadInfo& info) {
   return j;
 }
 
+Json mesh_repair_json(const MeshRepair& r, const std::string& output) {
+  return Json{{"split_vertices", r.split_vertices},
+              {"removed_unreferenced_vertices", r.removed_unreferenced_vertices},
+              {"renumbered", r.renumbered},
+              {"output", output}};
+}
+
 Json mesh_check_json(const std::string& file, const MeshCheck& c) {
   Json j;
   j["file"] = file;

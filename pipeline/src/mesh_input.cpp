@@ -1,6 +1,9 @@
 // Mesh input with its check and verdict (mesh_input.h).
 #include "spherekit/pipeline/mesh_input.h"
 
+#include <cstddef>
+#include <vector>
+
 #include "spherekit/file_status.h"
 #include "stopwatch.h"
 
@@ -38,7 +41,10 @@ Result<LoadedMesh> load_mesh_checked(const std::string& path, bool allow_boundar
 MeshRepair repair_mesh(LoadedMesh& m) {
   Stopwatch t;
   MeshRepair r;
-  r.removed_unreferenced_vertices = remove_unreferenced_vertices(m.mesh);
+  std::vector<int> old_to_new;
+  r.removed_unreferenced_vertices = remove_unreferenced_vertices(m.mesh, &old_to_new);
+  for (std::size_t v = 0; v < old_to_new.size(); ++v)
+    r.renumbered = r.renumbered || (old_to_new[v] >= 0 && old_to_new[v] != static_cast<int>(v));
   r.split_vertices = repair_pinched_vertices(m.mesh);
   m.split_vertices += r.split_vertices;
   m.check = check_mesh(m.mesh);

@@ -515,9 +515,20 @@ TEST_CASE("bad input: unreferenced vertices are refused with a hint and dropped 
   CHECK(r.exit_code == 0);  // the repaired mesh is accepted
   CHECK(r.out.find("\"removed_unreferenced_vertices\": 1") != std::string::npos);
   CHECK(r.out.find("\"unreferenced_vertices\": 0") != std::string::npos);
+  // The unused vertex is the last one: no other vertex changes its number.
+  CHECK(r.out.find("\"renumbered\": false") != std::string::npos);
   const CliRun text = run_cli("check " + quote(mesh) + " --repair -o " + quote(out.path("fixed2.obj")), dir);
   CHECK(text.out.find("removed 1 unreferenced vertex") != std::string::npos);
-  CHECK(text.out.find("landmark files of the input need remapping") != std::string::npos);
+  CHECK(text.out.find("need remapping") == std::string::npos);
+  // An unused vertex first: every other vertex moves down by one, which the repair says.
+  const std::string first = dir + "/unused_first.obj";
+  write_text(first, "v 7 7 7\nv 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+                    "f 2 4 6\nf 4 3 6\nf 3 5 6\nf 5 2 6\nf 4 2 7\nf 3 4 7\nf 5 3 7\nf 2 5 7\n");
+  require_failure(run_cli("check " + quote(first), dir), 3, first, "vertex 0 is used by no face");
+  const CliRun moved = run_cli("check " + quote(first) + " --repair -o " + quote(out.path("fixed3.obj")), dir);
+  CHECK(moved.exit_code == 0);
+  CHECK(moved.out.find("landmark files of the input need remapping") != std::string::npos);
+  CHECK(slurp(out.path("fixed3.obj")).find("v 7 7 7") == std::string::npos);
   const CliRun again = run_cli("check " + quote(out.path("fixed.obj")), dir);
   CHECK(again.exit_code == 0);
   CHECK(again.out.find("7 vertices") == std::string::npos);

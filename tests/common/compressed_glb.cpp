@@ -66,6 +66,40 @@ std::string glb_bytes(const GlbParts& parts) {
   return out;
 }
 
+std::string normalized_short_glb(const TriMesh& mesh, double& tolerance) {
+  const Eigen::RowVector3d lo = mesh.V.colwise().minCoeff(), hi = mesh.V.colwise().maxCoeff();
+  const Eigen::RowVector3d centre = (lo + hi) / 2;
+  const double half = (hi - lo).maxCoeff() / 2;
+  const auto nv = static_cast<std::size_t>(mesh.V.rows());
+  std::vector<std::int16_t> q(4 * nv, 0);  // padded to 8 bytes: attributes align to 4
+  for (std::size_t v = 0; v < nv; ++v)
+    for (int c = 0; c < 3; ++c)
+      q[4 * v + static_cast<std::size_t>(c)] = static_cast<std::int16_t>(
+          std::lround((mesh.V(static_cast<Eigen::Index>(v), c) - centre[c]) / half * 32767.0));
+  std::vector<std::uint32_t> indices(static_cast<std::size_t>(mesh.F.size()));
+  for (std::size_t i = 0; i < indices.size(); ++i) indices[i] = static_cast<std::uint32_t>(mesh.F.data()[i]);
+  GlbParts parts;
+  append_aligned(parts.bin, as_bytes(q));
+  const std::size_t i_at = append_aligned(parts.bin, as_bytes(indices));
+  using nlohmann::json;
+  json doc;
+  doc["asset"] = {{"version", "2.0"}};
+  doc["extensionsUsed"] = {"KHR_mesh_quantization"};
+  doc["extensionsRequired"] = {"KHR_mesh_quantization"};
+  doc["buffers"] = json::array({json{{"byteLength", parts.bin.size()}}});
+  doc["bufferViews"] = json::array({json{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 8 * nv}, {"byteStride", 8}},
+                                    json{{"buffer", 0}, {"byteOffset", i_at}, {"byteLength", 4 * indices.size()}}});
+  doc["accessors"] = json::array(
+      {json{{"bufferView", 0}, {"componentType", 5122}, {"normalized", true}, {"count", nv}, {"type", "VEC3"}},
+       json{{"bufferView", 1}, {"componentType", 5125}, {"count", indices.size()}, {"type", "SCALAR"}}});
+  doc["meshes"] = json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", 0}}}, {"indices", 1}}})}}});
+  doc["nodes"] = json::array({json{{"mesh", 0}, {"translation", {centre[0], centre[1], centre[2]}}, {"scale", {half, half, half}}}});
+  doc["scenes"] = json::array({json{{"nodes", {0}}}});
+  parts.json = doc;
+  tolerance = 0.5 * half / 32767.0 * (1 + 1e-9);
+  return glb_bytes(parts);
+}
+
 void require_read_error(const Status& status, ErrorCode code, const std::string& path, const std::string& phrase) {
   INFO("message: " << status.message());
   REQUIRE_FALSE(status.ok());

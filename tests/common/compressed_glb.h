@@ -35,6 +35,11 @@ enum class MeshoptGlb {
 /// `mesh` as a .glb of the given kind (one primitive).
 std::string meshopt_glb(const TriMesh& mesh, MeshoptGlb kind);
 
+/// `mesh` as a .glb with KHR_mesh_quantization only (no compression): positions as normalized
+/// signed shorts in [-1, 1] about the bounding box's centre, the node's scale and translation
+/// mapping them back. Returns the largest coordinate error the quantization allows in `tolerance`.
+std::string normalized_short_glb(const TriMesh& mesh, double& tolerance);
+
 /// A reader's refusal: `code`, one line starting "PATH: " and containing `phrase`.
 void require_read_error(const Status& status, ErrorCode code, const std::string& path, const std::string& phrase);
 

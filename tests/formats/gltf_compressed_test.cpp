@@ -65,6 +65,24 @@ TEST_CASE("glTF reader: meshopt-compressed and quantized GLBs read back within t
   }
 }
 
+TEST_CASE("glTF reader: KHR_mesh_quantization normalized shorts through the node transform", "[formats]") {
+  const std::string dir = test::temp_dir("formats_gltf_quantized");
+  TriMesh source = test::random_blob(2, 9);
+  source.V.col(0).array() -= 7.0;
+  double tolerance = 0;
+  const std::string path = write_bytes(dir, "normalized.glb", test::normalized_short_glb(source, tolerance));
+  Result<TriMesh> r = formats::read_mesh(path);
+  INFO(r.status().message());
+  REQUIRE(r.ok());
+  REQUIRE(r->F.rows() == source.F.rows());
+  double err = 0;
+  for (Eigen::Index t = 0; t < source.F.rows(); ++t)
+    for (int k = 0; k < 3; ++k)
+      err = std::max(err, (r->V.row(r->F(t, k)) - source.V.row(source.F(t, k))).cwiseAbs().maxCoeff());
+  CHECK(err <= tolerance);
+  CHECK(err > 0);
+}
+
 TEST_CASE("glTF reader: corrupt meshopt streams are refused in one line", "[formats]") {
   const std::string dir = test::temp_dir("formats_gltf_meshopt_bad");
   const TriMesh source = test::random_blob(2, 5);

@@ -23,26 +23,6 @@ struct CheckArgs {
   std::string landmarks;
 };
 
-void print_human(const std::string& path, const MeshCheck& c, const formats::ReadInfo& info, const Status& verdict) {
-  std::printf("%s: %d vertices, %d faces, %d edges\n", path.c_str(), c.vertices, c.faces, c.edges);
-  if (info.polygons_triangulated > 0)
-    std::printf("  file faces %lld: %lld triangles, %lld quads, %lld n-gons (polygons triangulated)\n",
-                static_cast<long long>(info.faces.faces), static_cast<long long>(info.faces.triangles),
-                static_cast<long long>(info.faces.quads), static_cast<long long>(info.faces.ngons));
-  std::printf("  components %d, boundary loops %d, Euler %d, genus %d, orientable %s\n", c.components,
-              c.boundary_loops, c.euler, c.genus, c.orientable ? "yes" : "no");
-  std::printf("  non-manifold edges %d, non-manifold vertices %d, orientation conflicts %d\n", c.nonmanifold_edges,
-              c.nonmanifold_vertices, c.orientation_conflicts);
-  std::printf("  faces: %d degenerate, %d duplicate, %d zero-area, %d invalid indices\n", c.degenerate_faces,
-              c.duplicate_faces, c.zero_area_faces, c.invalid_indices);
-  std::printf("  vertices: %d unreferenced, %d non-finite; bbox diagonal %.6g\n", c.unreferenced_vertices,
-              c.nonfinite_vertices, c.bbox_diag);
-  if (verdict.ok())
-    std::printf("  ok: genus-0 (%d hole%s)\n", c.boundary_loops, c.boundary_loops == 1 ? "" : "s");
-  else
-    std::printf("  not accepted: %s\n", verdict.message().c_str());
-}
-
 int run_check(const CheckArgs& args) {
   if (args.repair && args.meshes.size() != 1)
     return print_error(Status(ErrorCode::InvalidArgument, "--repair takes exactly one MESH"));
@@ -84,9 +64,7 @@ int run_check(const CheckArgs& args) {
       j["source_faces"] = source_faces_json(m.info);
       if (!verdict.ok()) j["error"] = verdict.message();
       if (args.repair)
-        j["repair"] = Json{{"split_vertices", repair.split_vertices},
-                           {"removed_unreferenced_vertices", repair.removed_unreferenced_vertices},
-                           {"output", args.output}};
+        j["repair"] = pipeline::mesh_repair_json(repair, args.output);
       if (!args.landmarks.empty()) {
         if (landmarks.ok())
           j["landmarks"] = Json{{"file", args.landmarks}, {"count", landmarks->size()}};
@@ -95,12 +73,12 @@ int run_check(const CheckArgs& args) {
       }
       report.push_back(std::move(j));
     } else {
-      print_human(path, m.check, m.info, verdict);
+      print_check_summary(m, verdict);
       if (args.repair)
-        std::printf("  repair: removed %d unreferenced vert%s, split %d pinched vertex fan%s; wrote %s%s\n", repair.removed_unreferenced_vertices,
-                    repair.removed_unreferenced_vertices == 1 ? "ex" : "ices", repair.split_vertices,
-                    repair.split_vertices == 1 ? "" : "s", args.output.c_str(),
-                    repair.removed_unreferenced_vertices > 0 ? " (vertex numbers changed: landmark files of the input need remapping)" : "");
+        std::printf("  repair: removed %d unreferenced vert%s, split %d pinched vertex fan%s; wrote %s%s\n",
+                    repair.removed_unreferenced_vertices, repair.removed_unreferenced_vertices == 1 ? "ex" : "ices",
+                    repair.split_vertices, repair.split_vertices == 1 ? "" : "s", args.output.c_str(),
+                    repair.renumbered ? " (vertex numbers changed: landmark files of the input need remapping)" : "");
       if (!args.landmarks.empty() && landmarks.ok())
         std::printf("  landmarks: %zu in %s, all valid\n", landmarks->size(), args.landmarks.c_str());
     }

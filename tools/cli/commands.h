@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "spherekit/status.h"
+
 namespace CLI {
 class App;
 }
@@ -19,6 +21,7 @@ struct CollectionPlanOptions;
 namespace pipeline {
 struct ConvertCollectionResult;
 struct ConvertMeshResult;
+struct LoadedMesh;
 struct MakeCollectionResult;
 struct AddToCollectionJob;
 struct AddToCollectionResult;
@@ -48,6 +51,8 @@ void register_morph(CLI::App& app);       // cmd_morph.cpp:    morph sequence be
 void register_pca(CLI::App& app);         // cmd_pca.cpp:      mean shape, components, errors, compression
 void register_submit(CLI::App& app);      // cmd_submit.cpp:   large collections as job arrays (local or Slurm)
 
+/// The report `check` prints for one mesh (its structure and param's verdict).
+void print_check_summary(const pipeline::LoadedMesh& mesh, const Status& verdict);
 /// The summary `convert` prints for one mesh.
 void print_mesh_summary(const pipeline::ConvertMeshResult& result);
 /// The summary `convert --collection` prints (per member on stderr, the total on stdout).

@@ -18,6 +18,29 @@ std::string db_text(const Json& x) { return x.is_number() ? format_text("%.1f", 
 
 }  // namespace
 
+void print_check_summary(const pipeline::LoadedMesh& m, const Status& verdict) {
+  const MeshCheck& c = m.check;
+  const formats::ReadInfo& info = m.info;
+  const std::string& path = m.path;
+  std::printf("%s: %d vertices, %d faces, %d edges\n", path.c_str(), c.vertices, c.faces, c.edges);
+  if (info.polygons_triangulated > 0)
+    std::printf("  file faces %lld: %lld triangles, %lld quads, %lld n-gons (polygons triangulated)\n",
+                static_cast<long long>(info.faces.faces), static_cast<long long>(info.faces.triangles),
+                static_cast<long long>(info.faces.quads), static_cast<long long>(info.faces.ngons));
+  std::printf("  components %d, boundary loops %d, Euler %d, genus %d, orientable %s\n", c.components,
+              c.boundary_loops, c.euler, c.genus, c.orientable ? "yes" : "no");
+  std::printf("  non-manifold edges %d, non-manifold vertices %d, orientation conflicts %d\n", c.nonmanifold_edges,
+              c.nonmanifold_vertices, c.orientation_conflicts);
+  std::printf("  faces: %d degenerate, %d duplicate, %d zero-area, %d invalid indices\n", c.degenerate_faces,
+              c.duplicate_faces, c.zero_area_faces, c.invalid_indices);
+  std::printf("  vertices: %d unreferenced, %d non-finite; bbox diagonal %.6g\n", c.unreferenced_vertices,
+              c.nonfinite_vertices, c.bbox_diag);
+  if (verdict.ok())
+    std::printf("  ok: genus-0 (%d hole%s)\n", c.boundary_loops, c.boundary_loops == 1 ? "" : "s");
+  else
+    std::printf("  not accepted: %s\n", verdict.message().c_str());
+}
+
 void print_mesh_summary(const pipeline::ConvertMeshResult& r) {
   const pipeline::ConvertMeshJob& a = r.job;
   const pipeline::GeometryAssets& g = r.assets;

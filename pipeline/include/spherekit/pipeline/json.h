@@ -10,6 +10,7 @@
 #include "spherekit/constrained_param.h"
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/metrics.h"
+#include "spherekit/pipeline/mesh_input.h"
 #include "spherekit/sphere_param.h"
 
 namespace spherekit::pipeline {
@@ -28,6 +29,8 @@ Json mesh_check_json(const std::string& file, const MeshCheck& check);
 /// when some polygon was triangulated, `face_polygon` (per triangle of the mesh, the 0-based
 /// face of the file it was cut from; absent means the identity). check --json and param's report.
 Json source_faces_json(const formats::ReadInfo& info);
+/// What `check --repair` did (repair_mesh) and where it wrote the mesh.
+Json mesh_repair_json(const MeshRepair& repair, const std::string& output);
 /// The options as recorded in reports.
 Json sphere_param_options_json(const SphereParamOptions& options);
 /// The constrained options as recorded in reports (the sphere options plus the network's).

@@ -29,11 +29,14 @@ Result<LoadedMesh> load_mesh(const std::string& path);
 struct MeshRepair {
   int removed_unreferenced_vertices = 0;  ///< remove_unreferenced_vertices
   int split_vertices = 0;                 ///< copies added by repair_pinched_vertices
+  /// A kept vertex got another number (a vertex dropped at the end changes none): landmark
+  /// files of the input no longer fit.
+  bool renumbered = false;
 };
 
 /// `check --repair`: drops vertices no face uses and splits pinched ones, the only repairs
 /// that leave the surface as it is (anything else would change it silently), then checks the
-/// mesh again. Dropping renumbers the vertices after a dropped one.
+/// mesh again.
 MeshRepair repair_mesh(LoadedMesh& mesh);
 
 /// What `param` accepts: the library's one verdict (require_param_accepts, check_mesh.h) with

@@ -71,7 +71,7 @@ endmacro()
 # One line per library. The private dependencies are listed because the libraries are static:
 # their link interface carries them (as $<LINK_ONLY:...>).
 spherekit_export_library(param PACKAGES "Eigen3 3.3 NO_MODULE" Threads OpenMP)
-spherekit_export_library(formats USES param PACKAGES "nlohmann_json 3")
+spherekit_export_library(formats USES param PACKAGES "nlohmann_json 3" "draco 1.5 CONFIG" "meshoptimizer CONFIG")
 spherekit_export_library(samples USES param formats
   HEADERS ${PROJECT_SOURCE_DIR}/samples/common/sample_collection.h HEADER_DESTINATION spherekit/samples)
 spherekit_export_library(convert USES param formats
@@ -148,7 +148,7 @@ set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_COMPONENT_DEV_DESCRIPTION "SphereKit C++ libraries (static), headers, CMake package and pkg-config file
 find_package(SphereKit) gives SphereKit::param, ::formats, ::samples and ::convert.")
 set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS
-    "g++, libeigen3-dev, nlohmann-json3-dev, libopenexr-dev, libtinygltf-dev, libdraco-dev, libosd-dev, libstb-dev, zlib1g-dev")
+    "g++, libeigen3-dev, nlohmann-json3-dev, libopenexr-dev, libtinygltf-dev, libdraco-dev, libmeshoptimizer-dev, libosd-dev, libstb-dev, zlib1g-dev")
 if(TARGET spherekit_python)
   # dpkg-shlibdeps cannot see these: an extension module does not link libpython.
   string(REGEX REPLACE "^([0-9]+)\\.([0-9]+)$" "\\1" _spherekit_py_major "${SPHEREKIT_PYTHON_VERSION}")

@@ -19,6 +19,7 @@
 #include "spherekit/formats/mesh_io.h"
 #include "test_meshes.h"
 #include "test_paths.h"
+#include "test_skip.h"
 
 namespace {
 
@@ -147,7 +148,7 @@ TEST_CASE("glTF reader: gltfpack -cc output (meshopt, quantized) equals its sour
   const test::NpmTools& tools = test::npm_tools();
   const std::string gltfpack = tools.node_dir + "/node_modules/.bin/gltfpack";
   if (!tools.available || !std::filesystem::exists(gltfpack)) {
-    WARN("SKIPPED: gltfpack is unavailable (scripts/setup_npm_tools.sh said: " << tools.why << ")");
+    SPHEREKIT_SKIP("gltfpack is unavailable (scripts/setup_npm_tools.sh said: " << tools.why << ")");
     return;
   }
   const std::string dir = test::temp_dir("convert_read_gltfpack");

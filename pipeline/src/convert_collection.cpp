@@ -167,6 +167,7 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
                                      convert::build_consistent_gltf_lods(images, lod_options, progress));
           RemeshErrorOptions psnr;
           psnr.samples = o.psnr_samples;
+          psnr.threads = o.threads;
           for (std::size_t k = 0; k < result.members.size(); ++k) {
             GeometryAssets& a = result.members[k].assets;
             a.lods = std::move(lods[k]);

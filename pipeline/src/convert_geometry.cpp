@@ -23,7 +23,14 @@ Status cancelled() { return Status(ErrorCode::Cancelled, "cancelled"); }
 GeometryImageOptions image_options(const ConvertOptions& o) {
   GeometryImageOptions g;
   g.fit_positions = o.positions == TexelPositions::Fit;
+  g.threads = o.threads;
   return g;
+}
+
+convert::CageFitOptions cage_options(const ConvertOptions& o) {
+  convert::CageFitOptions c;
+  c.threads = o.threads;
+  return c;
 }
 
 Result<std::vector<std::string>> write_previews(const GeometryImage& image, const std::string& prefix) {
@@ -48,10 +55,11 @@ Result<CageAssets> build_cage(const TriMesh& mesh, const RowMat3d& S, const Conv
   CageAssets out;
   SPHEREKIT_ASSIGN_OR_RETURN(convert::CageDomain domain, convert::cube_cage_domain(o.cage));
   SPHEREKIT_ASSIGN_OR_RETURN(convert::CageLimit limit, convert::CageLimit::create(domain));
-  SPHEREKIT_ASSIGN_OR_RETURN(convert::SubdCage cage, convert::fit_subd_cage(mesh, S, limit, domain, {}, progress));
+  SPHEREKIT_ASSIGN_OR_RETURN(convert::SubdCage cage, convert::fit_subd_cage(mesh, S, limit, domain, cage_options(o), progress));
   convert::DisplacementOptions dopt;
   dopt.tile = o.cage_tile;
   dopt.kind = o.displacement;
+  dopt.threads = o.threads;
   SPHEREKIT_ASSIGN_OR_RETURN(convert::DisplacementMap disp, convert::sample_displacement(mesh, S, cage, limit, dopt, progress));
   out.cage_path = names.prefix + "_cage.obj";
   out.displacement_path = names.prefix + "_disp.exr";
@@ -76,6 +84,7 @@ Result<CageAssets> build_cage(const TriMesh& mesh, const RowMat3d& S, const Conv
     Stopwatch t;
     RemeshErrorOptions opts;
     opts.samples = o.psnr_samples;
+    opts.threads = o.threads;
     std::vector<std::uint8_t> holes;
     const TriMesh displaced = convert::displaced_surface_mesh(cage, limit, &disp, 0, &holes);
     out.displaced_error = remesh_error(mesh, displaced, opts, holes);
@@ -106,6 +115,7 @@ Status check_convert_options(const ConvertOptions& o) {
   if (!is_geometry_image_size(o.size) || o.size > 16385)
     return bad(std::snprintf(text, sizeof text, "--size %d is not 2^k+1 (e.g. 65, 129, 257, 513)", o.size));
   if (o.psnr_samples < 0) return Status(ErrorCode::InvalidArgument, "--psnr-samples must be >= 0");
+  if (o.threads < 0) return Status(ErrorCode::InvalidArgument, "--threads must be >= 0 (0: all cores)");
   if (o.lods < 0 || o.lods > 30 || (o.lods > 0 && ((o.size - 1) >> (o.lods - 1)) < 2))
     return bad(std::snprintf(text, sizeof text, "--lods %d does not fit --size %d (the coarsest level needs >= 3 x 3 texels)",
                              o.lods, o.size));
@@ -143,6 +153,7 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
   // have no counterpart in the original); one mesh's PSNR over all faces is reported beside it.
   RemeshErrorOptions psnr;
   psnr.samples = o.psnr_samples;
+  psnr.threads = o.threads;
   if (o.psnr_samples > 0) {
     Stopwatch psnr_time;
     out.measured = true;

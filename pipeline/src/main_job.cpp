@@ -43,7 +43,6 @@ namespace {
 
 // glTF levels of detail per mesh from its image (129, 65, 33), for the page's 3-D view.
 constexpr int kGeometryImageLods = 3;
-Status cancelled() { return Status(ErrorCode::Cancelled, "cancelled"); }
 
 std::string stem_of(const std::string& path) { return fs::path(path).stem().string(); }
 
@@ -121,6 +120,7 @@ MeshOutcome run_one(const MainJob& a, const std::string& path, const std::string
   gio.size = kRunImageSize;
   gio.psnr_samples = kRunPsnrSamples;
   gio.lods = kGeometryImageLods;
+  gio.threads = a.options.threads;
   GeometryOutputs names;
   names.image = gim_path;
   names.prefix = output_prefix(gim_path);
@@ -318,7 +318,7 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
                                   {"rows", {{col["pairs"], col["mean_error"], col["under_0.05"], col["under_0.1"]}}}});
       }
       Json models_before = site["models"];
-      const Status stages = detail::run_collection_stages(col_dir, out_dir.string(), observer, site, report);
+      const Status stages = detail::run_collection_stages(col_dir, out_dir.string(), a.options.threads, observer, site, report);
       if (stages.code() == ErrorCode::Cancelled) return stages;
       out.collection_done = stages.ok();
       if (!stages.ok()) {

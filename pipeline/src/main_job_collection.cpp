@@ -24,7 +24,8 @@ constexpr int kCageTile = 9;
 // One transfer as `transfer` does it (default options). `tell`: the observer hears of it
 // (the colour round trip's way back is only measured).
 Status transfer(MainJobObserver& observer, const std::string& col, const std::string& from, const std::string& to,
-                TransferWhat what, const std::string& output, const std::string& attributes, bool tell = true) {
+                TransferWhat what, const std::string& output, const std::string& attributes, int threads,
+                bool tell = true) {
   TransferJob job;
   job.collection = col;
   job.from = from;
@@ -32,6 +33,7 @@ Status transfer(MainJobObserver& observer, const std::string& col, const std::st
   job.what = what;
   job.output = output;
   job.attributes = attributes;
+  job.threads = threads;
   SPHEREKIT_ASSIGN_OR_RETURN(TransferResult r, transfer_attributes(job));
   if (tell) observer.transferred(r, job);
   return Status();
@@ -45,8 +47,8 @@ double mean_color_distance(const RowMat3d& a, const RowMat3d& b) {
 
 }  // namespace
 
-Status run_collection_stages(const std::string& col_dir, const std::string& out_dir, MainJobObserver& observer,
-                             Json& site, Json& report) {
+Status run_collection_stages(const std::string& col_dir, const std::string& out_dir, int threads,
+                             MainJobObserver& observer, Json& site, Json& report) {
   auto info = formats::read_collection(col_dir);
   if (!info.ok()) return info.status();
   std::vector<std::string> names;
@@ -63,6 +65,7 @@ Status run_collection_stages(const std::string& col_dir, const std::string& out_
   cj.options.cage = kCage;
   cj.options.cage_tile = kCageTile;
   cj.options.psnr_samples = kRunPsnrSamples;
+  cj.options.threads = threads;
   auto converted = convert_collection(cj, observer.progress(""), [&] { return observer.keep_going(); });
   if (!converted.ok()) return converted.status();
   observer.assets_converted(converted.value());
@@ -117,13 +120,13 @@ Status run_collection_stages(const std::string& col_dir, const std::string& out_
   Json transfer_rows = Json::array();
   for (std::size_t k = 1; k < names.size(); ++k) {
     const std::string to = (tdir / (names[k] + "_colors.ply")).string();
-    SPHEREKIT_RETURN_IF_ERROR(transfer(observer, col_dir, names[0], names[k], TransferWhat::Colors, to, painted_path));
+    SPHEREKIT_RETURN_IF_ERROR(transfer(observer, col_dir, names[0], names[k], TransferWhat::Colors, to, painted_path, threads));
     transfer_rows.push_back({names[0], names[k], "colors", "apps/transfer/" + names[k] + "_colors.ply", nullptr});
   }
   {  // the round trip: first -> second -> first, compared with what was painted
     const std::string back = (tdir / (names[0] + "_colors_back.ply")).string();
     SPHEREKIT_RETURN_IF_ERROR(transfer(observer, col_dir, names[1], names[0], TransferWhat::Colors, back,
-                                       (tdir / (names[1] + "_colors.ply")).string(), /*tell=*/false));
+                                       (tdir / (names[1] + "_colors.ply")).string(), threads, /*tell=*/false));
     auto read_back = formats::read_mesh_with_attributes(back);
     if (!read_back.ok()) return read_back.status();
     const double err = mean_color_distance(read_back->attributes.colors, painted.colors);
@@ -133,7 +136,7 @@ Status run_collection_stages(const std::string& col_dir, const std::string& out_
     observer.round_trip(names[0], names[1], err);
   }
   const std::string normals_out = (tdir / (names[1] + "_normals.obj")).string();
-  SPHEREKIT_RETURN_IF_ERROR(transfer(observer, col_dir, names[0], names[1], TransferWhat::Normals, normals_out, ""));
+  SPHEREKIT_RETURN_IF_ERROR(transfer(observer, col_dir, names[0], names[1], TransferWhat::Normals, normals_out, "", threads));
   transfer_rows.push_back({names[0], names[1], "normals (normal map)", "apps/transfer/" + names[1] + "_normals.obj",
                            nullptr});
   site["tables"].push_back({{"label", "Attribute transfer through the sphere (round trip: mean RGB distance)"},
@@ -150,6 +153,7 @@ Status run_collection_stages(const std::string& col_dir, const std::string& out_
     job.a = names[0];
     job.b = names[1];
     job.output = (fs::path(out_dir) / "apps" / "morph").string();
+    job.threads = threads;
     SPHEREKIT_ASSIGN_OR_RETURN(MorphResult r, morph_members(job, observer.progress("morph"), [&] { return observer.keep_going(); }));
     observer.morphed(r, job);
   }
@@ -163,6 +167,7 @@ Status run_collection_stages(const std::string& col_dir, const std::string& out_
   PcaJob pca_job;
   pca_job.collection = col_dir;
   pca_job.output = pca_dir;
+  pca_job.threads = threads;
   auto pca = shape_pca(pca_job, observer.progress("pca"), [&] { return observer.keep_going(); });
   if (!pca.ok()) return pca.status();
   observer.pca_done(pca.value(), pca_job);

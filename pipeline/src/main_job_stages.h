@@ -12,7 +12,8 @@ namespace spherekit::pipeline::detail {
 /// with 9 x 9 scalar displacement) and runs the applications into OUT/apps (colour and normal
 /// transfer, a morph of the first two members, PCA with the compression experiment). Adds what
 /// it made to `site` (models, morphs, plots, tables) and `report`.
-Status run_collection_stages(const std::string& col_dir, const std::string& out_dir, MainJobObserver& observer,
-                             Json& site, Json& report);
+/// `threads`: of every stage (0: all cores; the outputs do not depend on it).
+Status run_collection_stages(const std::string& col_dir, const std::string& out_dir, int threads,
+                             MainJobObserver& observer, Json& site, Json& report);
 
 }  // namespace spherekit::pipeline::detail

@@ -45,7 +45,7 @@ Result<MorphResult> morph_members(const MorphJob& a, const ProgressFn& progress,
   if (!B.ok()) return B.status();
 
   SPHEREKIT_ASSIGN_OR_RETURN(std::vector<convert::ConsistentRemesh> remeshes,
-                             convert::consistent_remeshes({A->mesh, B->mesh}, {A->map.S, B->map.S}, a.size, {}, progress));
+                             convert::consistent_remeshes({A->mesh, B->mesh}, {A->map.S, B->map.S}, a.size, GeometryImageOptions{.threads = a.threads}, progress));
   convert::MorphOptions o;
   o.frames = a.frames;
   o.align = a.align;

@@ -69,7 +69,7 @@ Result<PcaResult> shape_pca(const PcaJob& a, const ProgressFn& progress,
   convert::ShapePca pca;
   convert::PcaErrorTable table;
   {
-    auto r = convert::consistent_remeshes(meshes, maps, a.size, {}, progress);
+    auto r = convert::consistent_remeshes(meshes, maps, a.size, GeometryImageOptions{.threads = a.threads}, progress);
     if (!r.ok()) return r.status();
     for (auto& rm : r.value()) shapes.push_back(std::move(rm.mesh));
     auto p = convert::compute_shape_pca(shapes);

@@ -140,9 +140,9 @@ Result<TransferResult> transfer_attributes(const TransferJob& a) {
       if (sim.ok()) R = sim->R;
     }
     rep["rotation"] = {{R(0, 0), R(0, 1), R(0, 2)}, {R(1, 0), R(1, 1), R(1, 2)}, {R(2, 0), R(2, 1), R(2, 2)}};
-    auto ra = convert::consistent_remesh(A->mesh, A->map.S, a.size);
+    auto ra = convert::consistent_remesh(A->mesh, A->map.S, a.size, GeometryImageOptions{.threads = a.threads});
     if (!ra.ok()) return ra.status().with_context(A->name);
-    auto rb = convert::consistent_remesh(B->mesh, B->map.S, a.size);
+    auto rb = convert::consistent_remesh(B->mesh, B->map.S, a.size, GeometryImageOptions{.threads = a.threads});
     if (!rb.ok()) return rb.status().with_context(B->name);
     auto map = convert::bake_normal_map(ra->image, R);
     if (!map.ok()) return map.status();

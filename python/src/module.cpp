@@ -151,4 +151,5 @@ PYBIND11_MODULE(spherekit, m) {
   spherekit::py::bind_param(m);
   spherekit::py::bind_formats(m);
   spherekit::py::bind_convert(m);
+  spherekit::py::bind_pipeline(m);
 }

@@ -82,5 +82,6 @@ void bind_mesh_and_errors(pyb::module_& m);
 void bind_param(pyb::module_& m);
 void bind_formats(pyb::module_& m);
 void bind_convert(pyb::module_& m);
+void bind_pipeline(pyb::module_& m);
 
 }  // namespace spherekit::py

@@ -144,6 +144,12 @@ TEST_CASE("transfer, morph and pca on a consistent sample collection", "[cli][ap
     r = sk("morph " + q(col) + " sample_a sample_b -o " + q(out + "/morph") + " --frames 2 --size 17 -q", dir);
     REQUIRE(r.exit_code == 0);
     CHECK_FALSE(fs::exists(out + "/morph/frame_003.obj"));
+    // --threads changes the effort, never the bytes.
+    for (const char* t : {"1", "2"})
+      REQUIRE(sk("morph " + q(col) + " sample_a sample_b -o " + q(out + "/morph_t" + t) + " --frames 2 --size 17 -q " +
+                     "--threads " + t, dir).exit_code == 0);
+    for (const char* f : {"morph.glb", "frame_000.obj", "frame_001.obj"})
+      CHECK(slurp(out + "/morph_t1/" + f) == slurp(out + "/morph_t2/" + f));
   }
 
   {  // pca: mean, components, error table, plots, compression
@@ -165,6 +171,11 @@ TEST_CASE("transfer, morph and pca on a consistent sample collection", "[cli][ap
     bool draco = false;
     for (const json& c : p["compression"]) draco = draco || c["method"] == "draco";
     CHECK(draco);
+    for (const char* t : {"1", "2"})
+      REQUIRE(sk("pca " + q(col) + " -o " + q(out + "/pca_t" + t) + " --size 17 --no-compression -q --threads " + t, dir)
+                  .exit_code == 0);
+    for (const char* f : {"mean.obj", "pc1_plus.obj", "pca.glb", "pca_errors.csv"})
+      CHECK(slurp(out + "/pca_t1/" + f) == slurp(out + "/pca_t2/" + f));
   }
 
   {  // bad arguments fail cleanly and write nothing

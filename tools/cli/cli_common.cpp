@@ -247,6 +247,11 @@ void add_hidden_alias(CLI::App& command, const std::string& name, T& value) {
   command.add_option(name, value)->group("");
 }
 
+void add_threads_option(CLI::App& command, int& threads) {
+  command.add_option("--threads", threads, "worker threads, 0 = all cores (results do not depend on it)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+}
+
 void add_sphere_param_options(CLI::App& command, SphereParamOptions& o) {
   // One line per field; flag name = field name in kebab case, so the two cannot drift
   // (DESIGN 3.4). The snake-case spellings of earlier versions stay as hidden aliases.
@@ -254,8 +259,7 @@ void add_sphere_param_options(CLI::App& command, SphereParamOptions& o) {
       ->check(CLI::Range(0, 5))->capture_default_str();
   command.add_option("--seed", o.seed, "seed of every random choice (results are deterministic)")
       ->capture_default_str();
-  command.add_option("--threads", o.threads, "worker threads, 0 = all cores (results do not depend on it)")
-      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  add_threads_option(command, o.threads);
   command.add_option("--regularizer-weight", o.regularizer_weight,
                      "weight of the term against collapsed sphere triangles (shape-defining)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();

@@ -195,6 +195,8 @@ using pipeline::param_verdict;
 CLI::App* add_command(CLI::App& app, const std::string& name, const std::string& summary,
                       const std::string& paragraph, const std::string& examples);
 
+/// --threads N into `threads` (0: all cores); one wording for every command.
+void add_threads_option(CLI::App& command, int& threads);
 /// Adds one flag per SphereParamOptions field, named exactly like the field (DESIGN 3.4),
 /// bound to `options` (which must outlive parsing).
 void add_sphere_param_options(CLI::App& command, SphereParamOptions& options);

@@ -113,6 +113,7 @@ void register_convert(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(
           std::map<std::string, convert::DisplacementKind>{{"scalar", convert::DisplacementKind::Scalar},
                                                            {"vector", convert::DisplacementKind::Vector}}));
+  add_threads_option(*cmd, args->options.threads);
   cmd->add_flag("-q,--quiet", args->quiet, "print no summary (errors still)");
   cmd->callback([args] { set_exit_code(run_convert(*args)); });
 }

@@ -61,6 +61,7 @@ void register_morph(CLI::App& app) {
   cmd->add_flag("--rigid", args->job.rigid, "align without scaling");
   cmd->add_option("--seconds", args->job.seconds, "length of the glTF animation")
       ->check(CLI::PositiveNumber)->capture_default_str();
+  add_threads_option(*cmd, args->job.threads);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->callback([args] { set_exit_code(run_morph(*args)); });
 }

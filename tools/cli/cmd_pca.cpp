@@ -55,6 +55,7 @@ void register_pca(CLI::App& app) {
   cmd->add_option("-o,--output", args->job.output, "output folder")->required();
   cmd->add_option("--size", args->job.size, "geometry-image size of the remeshes, 2^k+1")->capture_default_str();
   cmd->add_flag("--no-compression", args->no_compression, "skip the compression experiment");
+  add_threads_option(*cmd, args->job.threads);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->callback([args] { set_exit_code(run_pca(*args)); });
 }

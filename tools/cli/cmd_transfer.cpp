@@ -71,6 +71,7 @@ void register_transfer(CLI::App& app) {
   cmd->add_option("--size", args->job.size, "normals: normal map and remesh size, 2^k+1")->capture_default_str();
   cmd->add_flag("--no-align", args->no_align, "normals: do not rotate A's normals into B's orientation");
   cmd->add_option("--report", args->report, "write a JSON report here");
+  add_threads_option(*cmd, args->job.threads);
   cmd->add_flag("-q,--quiet", args->quiet, "print nothing but errors");
   cmd->callback([args] { set_exit_code(run_transfer(*args)); });
 }

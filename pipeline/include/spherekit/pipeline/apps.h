@@ -25,6 +25,7 @@ struct TransferJob {
   std::string texture;     ///< A's texture image (texture; default: from A's material library)
   int size = 129;          ///< normals: normal map and remesh size, 2^k+1
   bool align = true;       ///< normals: rotate A's normals into B's orientation (features)
+  int threads = 0;         ///< effort: remeshing threads (0: all cores); same output for any
 };
 
 struct TransferResult {
@@ -48,6 +49,7 @@ struct MorphJob {
   bool align = true;             ///< align with the features (false: linear blend)
   bool rigid = false;            ///< align without scaling
   double seconds = 3;            ///< length of the glTF animation
+  int threads = 0;               ///< effort: remeshing threads (0: all cores); same output for any
 };
 
 struct MorphResult {
@@ -69,6 +71,7 @@ struct PcaJob {
   std::string collection, output;  ///< the folder is written all-or-nothing (marker pca.json)
   int size = 65;                   ///< geometry-image size of the remeshes, 2^k+1
   bool compression = true;         ///< run the compression experiment (PCA against Draco)
+  int threads = 0;                 ///< effort: remeshing threads (0: all cores); same output for any
 };
 
 struct PcaResult {

@@ -43,6 +43,7 @@ struct ConvertOptions {
   int cage = 0;                                     ///< cage quads per cube-face edge (0: no cage)
   int cage_tile = 17;                               ///< displacement samples per quad edge
   convert::DisplacementKind displacement = convert::DisplacementKind::Scalar;
+  int threads = 0;  ///< effort: worker threads of the parallel stages (0: all cores); same bytes for any
 };
 
 /// InvalidArgument naming the option (as its flag) when `o` is wrong whatever the input.

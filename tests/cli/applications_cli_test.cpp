@@ -16,13 +16,7 @@
 #include "spherekit/formats/mesh_io.h"
 #include "test_paths.h"
 
-namespace fs = std::filesystem;
-using nlohmann::json;
-using spherekit::test::CliRun;
-using spherekit::test::q;
-using spherekit::test::read_json;
-using spherekit::test::sk;
-using spherekit::test::slurp;
+#include "cli_test_prelude.h"
 
 namespace {
 

@@ -17,13 +17,7 @@
 #include "test_paths.h"
 #include "test_files.h"
 
-namespace fs = std::filesystem;
-using nlohmann::json;
-using spherekit::test::CliRun;
-using spherekit::test::q;
-using spherekit::test::read_json;
-using spherekit::test::sk;
-using spherekit::test::slurp;
+#include "cli_test_prelude.h"
 
 namespace {
 

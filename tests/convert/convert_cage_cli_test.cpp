@@ -22,14 +22,9 @@
 #include "test_meshes.h"
 #include "test_paths.h"
 
-namespace fs = std::filesystem;
+#include "cli_test_prelude.h"
+
 using namespace spherekit;
-using nlohmann::json;
-using spherekit::test::CliRun;
-using spherekit::test::q;
-using spherekit::test::read_json;
-using spherekit::test::sk;
-using spherekit::test::slurp;
 
 namespace {
 

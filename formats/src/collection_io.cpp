@@ -109,6 +109,10 @@ CollectionFeature feature_of(const Json& f) {
   const Json* q = f.contains("initial_location") ? &f["initial_location"] : nullptr;
   if (q && q->is_array() && q->size() == 3 && std::all_of(q->begin(), q->end(), [](const Json& x) { return x.is_number(); }))
     out.initial_location = Eigen::Vector3d((*q)[0].get<double>(), (*q)[1].get<double>(), (*q)[2].get<double>());
+  // Everything else (a label, a malformed initial_location) is kept as it is.
+  for (auto it = f.begin(); it != f.end(); ++it)
+    if (it.key() != "name" && it.key() != "location" && (it.key() != "initial_location" || !out.initial_location))
+      out.extra[it.key()] = it.value();
   return out;
 }
 
@@ -248,6 +252,7 @@ OrderedJson collection_manifest_json(const CollectionManifest& c) {
   for (const CollectionFeature& f : c.features) {
     Json j{{"name", f.name}, {"location", vector_json(f.location)}};
     if (f.initial_location) j["initial_location"] = vector_json(*f.initial_location);
+    for (auto it = f.extra.begin(); it != f.extra.end(); ++it) j[it.key()] = it.value();
     m["features"].push_back(std::move(j));
   }
   m["meshes"] = Json::array();

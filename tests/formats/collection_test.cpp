@@ -86,6 +86,7 @@ TEST_CASE("collection manifest: written, read back and written again gives the s
   // Keys the format does not know are kept, in their place among the others.
   const std::string with_extra = manifest_with([](OrderedJson& j) {
     j["meshes"][0]["note"] = "hand-written";
+    j["features"][1]["label"] = "tip of the left ear";
     j["future"] = {1, 2};
   });
   auto extra = formats::parse_collection_manifest(with_extra, "collection.json");

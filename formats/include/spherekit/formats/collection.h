@@ -35,6 +35,7 @@ struct CollectionFeature {
   std::string name;
   Eigen::Vector3d location = Eigen::Vector3d::Zero();  ///< F: a unit vector
   std::optional<Eigen::Vector3d> initial_location;     ///< F' (from the reference), if recorded
+  OrderedJson extra = OrderedJson::object();           ///< other keys of the entry, in file order
 };
 
 struct CollectionMember {

@@ -6,6 +6,7 @@
 // ALGORITHM.md §5.1-5.2 and §7 gotchas 9 and 11.
 #include "spherekit/convert/gltf_lods.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -114,8 +115,9 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
     AdaptiveLodOptions a;
     a.levels = options.levels;
     a.lod0_vertex_fraction = options.lod0_vertex_fraction;
+    a.drop_hole_faces = options.drop_hole_faces;  // exactly, by the simplifier's rim constraint
     SPHEREKIT_ASSIGN_OR_RETURN(auto all, adaptive_lod_meshes({image}, a, progress));
-    return build_from_meshes(adaptive_member_levels(all, 0, image, options.drop_hole_faces),
+    return build_from_meshes(adaptive_member_levels(all, 0, image, false),
                              std::vector<int>(static_cast<std::size_t>(options.levels), image.size), image.size,
                              options, progress);
   }
@@ -194,6 +196,28 @@ Result<std::vector<GltfLods>> build_consistent_gltf_lods(const std::vector<Geome
 
 namespace {
 
+// Position bits of a coarse adaptive level from its own error: the RMS distance between it
+// and level 0 (both directions, sampled, deterministic) stands for its error against the
+// original (level 0's own is smaller and adds in squares). Same rule as
+// choose_draco_quantization: step/2 <= fraction * error.
+QuantizationChoice coarse_quantization(const QuantizationChoice& shared, const GltfMesh& finest, const GltfMesh& level,
+                                       const GltfLodOptions& options) {
+  QuantizationChoice q = shared;
+  RemeshErrorOptions eo;
+  eo.samples = 20000;
+  const RemeshError e = remesh_error(TriMesh{finest.V, finest.F}, TriMesh{level.V, level.F}, eo);
+  if (!(e.rms > 0) || !std::isfinite(e.rms)) return q;
+  const double needed = static_cast<double>(shared.quantization.position_range) /
+                        (2.0 * options.budget.position_error_fraction * e.rms);
+  const int bits = static_cast<int>(std::clamp(std::ceil(std::log2(needed + 1.0)),
+                                               static_cast<double>(options.coarse_position_bits),
+                                               static_cast<double>(shared.quantization.position_bits)));
+  q.quantization.position_bits = bits;
+  q.reference_rms_error = e.rms;
+  q.position_max_error = q.quantization.position_step() / 2;
+  return q;
+}
+
 Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
                                    const GltfLodOptions& options, const ProgressFn& progress) {
   const int levels = static_cast<int>(meshes.size());
@@ -224,11 +248,17 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     GltfLodLevel level;
     level.image_size = sizes[static_cast<std::size_t>(k)];
     level.mesh = std::move(meshes[static_cast<std::size_t>(k)]);
-    SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(level.mesh, encode));
+    if (!options.normals) level.mesh.N.resize(0, 3);
+    level.quantization = out.quantization;
+    if (k > 0 && options.mode == LodMode::Adaptive && options.coarse_position_bits > 0)
+      level.quantization = coarse_quantization(out.quantization, out.levels[0].mesh, level.mesh, options);
+    DracoEncodeOptions level_encode = encode;
+    level_encode.quantization = level.quantization.quantization;
+    SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(level.mesh, level_encode));
 
     detail::GlbBuilder doc;
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, out.quantization, options.mode));
+                                     level_extras(k, level.image_size, n, level.quantization, options.mode));
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;
@@ -252,7 +282,7 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
   for (int k = 0; k < levels; ++k) {
     const GltfLodLevel& level = out.levels[static_cast<std::size_t>(k)];
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, out.quantization, options.mode));
+                                     level_extras(k, level.image_size, n, level.quantization, options.mode));
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;

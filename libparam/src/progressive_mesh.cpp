@@ -303,6 +303,10 @@ class Simplifier {
           Eigen::Vector3d n0 = (p[1] - p[0]).cross(p[2] - p[0]);
           Eigen::Vector3d n1 = (q[1] - q[0]).cross(q[2] - q[0]);
           // Reject flips and near-degenerate results: cosine of the normal change > 0.
+          if (opt_.degenerate_faces_free &&
+              n0.norm() <= 1e-12 * ((p[1] - p[0]).squaredNorm() + (p[2] - p[1]).squaredNorm() +
+                                     (p[0] - p[2]).squaredNorm()))
+            continue;  // no orientation before: nothing to flip
           if (!(n0.dot(n1) > 0)) return false;
           q_old = std::min(q_old, quality(p, n0));
           q_new = std::min(q_new, quality(q, n1));

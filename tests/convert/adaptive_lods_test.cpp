@@ -101,3 +101,64 @@ TEST_CASE("Adaptive LODs: bad options", "[convert]") {
         ErrorCode::InvalidArgument);
   CHECK(build_consistent_gltf_lods({test::blob_geometry_image(17)}, {}).status().code() == ErrorCode::InvalidArgument);
 }
+
+namespace {
+
+double surface_area(const RowMat3d& V, const RowMat3i& F) {
+  double a = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    a += 0.5 * (V.row(F(f, 1)) - V.row(F(f, 0))).cross(V.row(F(f, 2)) - V.row(F(f, 0))).norm();
+  return a;
+}
+
+}  // namespace
+
+TEST_CASE("Adaptive LODs of a mesh with holes: the holes stay their size at every level", "[convert]") {
+  // The fitted image holds hole texels on the rim (zero-area faces). Before the rim was a
+  // simplifier constraint and degenerate faces stopped vetoing collapses, the simplifier
+  // stalled on them, forced fold-overs, and coarse faces half over a hole were dropped with
+  // their surface (bunny's coarsest level: half its area, 22.7 dB).
+  const test::HoledLodImages holed = test::holed_lod_images(65, 1);
+  const GeometryImage& gi = holed.levels[0];
+  REQUIRE(gi.texels_in_holes > 0);
+  const TriMesh open = geometry_image_open_mesh(gi);
+  const double open_area = surface_area(open.V, open.F);
+  // Three levels: the fourth of a 65 x 65 image has ~16 vertices, too coarse for its area to
+  // say anything about holes.
+  GltfLodOptions o = adaptive_options(3);
+  o.drop_hole_faces = true;
+  auto built = build_gltf_lods(gi, o);
+  REQUIRE(built.ok());
+  for (const GltfLodLevel& level : built->levels) {
+    const GltfMesh& d = level.primitive.decoded.mesh;
+    INFO("faces " << d.F.rows() << " area ratio " << surface_area(d.V, d.F) / open_area);
+    CHECK(std::abs(surface_area(d.V, d.F) / open_area - 1) < 0.05);
+  }
+}
+
+TEST_CASE("Adaptive LODs: coarse levels' position bits from their own error; no normals on request", "[convert]") {
+  const GeometryImage gi = test::blob_geometry_image(65, 3, 7);
+  GltfLodOptions o = adaptive_options(4);
+  o.normals = false;
+  o.coarse_position_bits = 6;
+  auto built = build_gltf_lods(gi, o);
+  REQUIRE(built.ok());
+  const int shared = built->quantization.quantization.position_bits;
+  CHECK(built->levels[0].quantization.quantization.position_bits == shared);
+  int previous = shared;
+  for (std::size_t k = 0; k < built->levels.size(); ++k) {
+    const GltfLodLevel& level = built->levels[k];
+    const int bits = level.quantization.quantization.position_bits;
+    INFO("level " << k << " bits " << bits);
+    CHECK(bits <= previous);  // coarser levels have larger errors
+    CHECK(bits >= 6);
+    previous = bits;
+    CHECK(level.primitive.decoded.mesh.N.rows() == 0);
+    CHECK(level.primitive.decoded.mesh.V.rows() > 0);
+    // The quantization error stays a small part of the level's error (budget fraction 0.1).
+    if (k > 0) CHECK(level.quantization.position_max_error <= 0.1 * level.quantization.reference_rms_error + 1e-12);
+  }
+  CHECK(built->levels.back().quantization.quantization.position_bits < shared);
+  const std::string json = built->levels.back().glb.substr(20, 4000);
+  CHECK(json.find("\"NORMAL\"") == std::string::npos);
+}

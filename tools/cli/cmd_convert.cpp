@@ -99,6 +99,12 @@ void register_convert(CLI::App& app) {
                   "of the remesh; a collection's members share each level's connectivity)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, convert::LodMode>{
           {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}}));
+  cmd->add_flag("!--no-lod-normals", args->options.lod_normals,
+                "glTF levels without NORMAL (a viewer derives them from the triangles, as for gltfpack -cc "
+                "output); single meshes");
+  cmd->add_option("--lod-coarse-position-bits", args->options.lod_coarse_position_bits,
+                  "adaptive glTF levels 1..: position bits from each level's own error, at least this many "
+                  "(default 0: all levels use level 0's bits)");
   cmd->add_option("--min-position-bits", args->options.budget.min_position_bits,
                   "glTF: fewest Draco position bits (default 14; more if the error budget needs them)");
   cmd->add_option("--normal-bits", args->options.budget.normal_bits, "glTF: Draco normal bits (default 10)");

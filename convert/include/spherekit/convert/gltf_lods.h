@@ -76,6 +76,15 @@ struct GltfLodOptions {
   /// Leave out the faces spanning holes of the mesh (and the points only they use). Changes
   /// the connectivity from member to member of a collection, so collections keep them.
   bool drop_hole_faces = false;
+  /// Write NORMAL. Without it a viewer computes the normals from the triangles (glTF 2.0
+  /// §3.7.2.1: flat normals), as it does for gltfpack -cc and gltf-transform output of a mesh
+  /// without normals; 10-bit octahedral normals are about a third of an adaptive level's bytes.
+  bool normals = true;
+  /// Adaptive levels 1..L-1: position bits from the level's own error (RMS distance to level
+  /// 0, sampled) with the budget's error fraction, floored at this many bits (0: off, every
+  /// level has the shared bits). A coarse level's error is many times level 0's, so the bits
+  /// level 0 needs are far below its error and only cost bytes.
+  int coarse_position_bits = 0;
   std::string name = "mesh";    ///< node and mesh names: NAME_LOD0, NAME_LOD1, ...
   GltfProvenance provenance;
   // Effort
@@ -89,6 +98,9 @@ struct GltfLodLevel {
   int image_size = 0;
   GltfMesh mesh;              ///< the level before Draco (point order of the source)
   DracoPrimitive primitive;   ///< the Draco bitstream and its decode
+  /// The level's quantization: GltfLods::quantization, except for the position bits of
+  /// coarser adaptive levels (GltfLodOptions::coarse_position_bits).
+  QuantizationChoice quantization;
   std::string glb;            ///< the level alone as a .glb
 };
 

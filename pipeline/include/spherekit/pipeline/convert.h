@@ -39,6 +39,8 @@ struct ConvertOptions {
   /// How the levels are made (gltf_lods.h). Uniform by default: measured against gltfpack and
   /// gltf-transform at equal PSNR (issue 22), the adaptive levels do not win yet.
   convert::LodMode lod_mode = convert::LodMode::Uniform;
+  bool lod_normals = true;
+  int lod_coarse_position_bits = 0;  ///< GltfLodOptions::coarse_position_bits (adaptive single meshes)  ///< glTF levels carry NORMAL (GltfLodOptions::normals; single meshes)
   convert::QuantizationBudget budget;               ///< their Draco quantization
   int cage = 0;                                     ///< cage quads per cube-face edge (0: no cage)
   int cage_tile = 17;                               ///< displacement samples per quad edge

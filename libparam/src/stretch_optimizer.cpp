@@ -219,6 +219,10 @@ OptimizerSettings settings_for_effort(int effort) {
     default: s.line_search_iter = 200; s.vsplit_vt_iter = 5; s.vsplit_nei_iter = 20; s.global_iter = 20; s.movetol = 3e-4; s.nv_ratio = 1.04; break;
   }
   s.final_iter = s.global_iter;
+  // Rounds by colour classes (optimize_all): measured side by side on gargoyle 4.2 -> 2.5 CPU s
+  // at the same efficiency; on the generated limb shapes with holes, where the greedy rounds
+  // wasted most moves, tentacles-holes 0.0899 -> 0.1577 in 63 -> 26 s.
+  s.coloured_rounds = true;
   return s;
 }
 
@@ -446,6 +450,7 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
   double e0 = ring_energy(st, ring, x, s.regularizer_weight, s.split_distance);
   if (!std::isfinite(e0)) e0 = std::numeric_limits<double>::max();
   double ecur = e0;
+
   bool improved = false;
   if (s.newton) {
     // Newton steps first; a random-direction search only where Newton cannot proceed
@@ -518,10 +523,106 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   // Per-vertex marks instead of arrays cleared every round: a round costs time in
   // proportion to its active vertices, not to the mesh (late rounds have a few dozen).
   std::vector<int> locked_in(static_cast<size_t>(nv), -1), listed_in(static_cast<size_t>(nv), -1);
-  std::vector<int> order, next, keep;
+  std::vector<int> order, next, keep, colour;
+  std::vector<int> colour_of(static_cast<size_t>(nv), -1);
+  // Activity threshold: absolute (the reference's movetol), or relative to the vertex's
+  // shortest chord to a neighbour, so that convergence is judged at the scale of the local
+  // triangles: coarse levels stop sooner, compressed regions (thin legs) are refined longer.
+  auto activity_tol = [&](int v) {
+    double tol = s.movetol;
+    if (s.movetol_rel > 0) {
+      double shortest = kInf;
+      const Eigen::Vector3d x = st.S.row(v).transpose();
+      for (int f : st.vf[static_cast<size_t>(v)])
+        for (int k = 0; k < 3; ++k) {
+          const int w = st.F[static_cast<size_t>(f)][k];
+          if (w != v) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
+        }
+      tol = std::min(s.movetol, s.movetol_rel * shortest);
+    }
+    return tol;
+  };
   int round = 0;
   for (; round < s.max_rounds && !active.empty(); ++round) {
     if (keep_going && !keep_going()) return -1;
+    if (s.coloured_rounds) {
+      // Colour the active vertices greedily (by id, smallest colour unused by an already
+      // coloured active neighbour), then run the colour classes one after another: a class
+      // is an independent set (no two of its vertices share a face), so every move computed
+      // is applied, from positions that include the earlier classes' moves (Gauss-Seidel
+      // by colour). The greedy set of the plain rounds keeps only about a quarter of the
+      // moves of a full round and recomputes the others.
+      const int na = static_cast<int>(active.size());
+      colour.assign(active.size(), 0);
+      int ncol = 0;
+      for (int i = 0; i < na; ++i) colour_of[static_cast<size_t>(active[static_cast<size_t>(i)])] = -1;
+      for (int i = 0; i < na; ++i) listed_in[static_cast<size_t>(active[static_cast<size_t>(i)])] = round;
+      for (int i = 0; i < na; ++i) {
+        const int v = active[static_cast<size_t>(i)];
+        std::uint64_t used = 0;
+        for (int f : st.vf[static_cast<size_t>(v)])
+          for (int k = 0; k < 3; ++k) {
+            const int w = st.F[static_cast<size_t>(f)][k];
+            if (w != v && listed_in[static_cast<size_t>(w)] == round && colour_of[static_cast<size_t>(w)] >= 0 &&
+                colour_of[static_cast<size_t>(w)] < 64)
+              used |= std::uint64_t{1} << colour_of[static_cast<size_t>(w)];
+          }
+        int c = 0;
+        while (c < 64 && (used >> c & 1)) ++c;  // > 63 coloured neighbours: impossible in practice, 64 is safe
+        colour_of[static_cast<size_t>(v)] = c;
+        colour[static_cast<size_t>(i)] = c;
+        ncol = std::max(ncol, c + 1);
+      }
+      cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
+      next.clear();
+      for (int i = 0; i < na; ++i) next.push_back(active[static_cast<size_t>(i)]);
+      std::vector<int>& cls = order;
+      for (int c = 0; c < ncol; ++c) {
+        cls.clear();
+        for (int i = 0; i < na; ++i)
+          if (colour[static_cast<size_t>(i)] == c) cls.push_back(i);
+        workers.parallel_for(static_cast<int>(cls.size()), 16, 64, [&](int j, int thread) {
+          const int i = cls[static_cast<size_t>(j)];
+          const int v = active[static_cast<size_t>(i)];
+          const std::uint64_t key = mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL +
+                                                       static_cast<std::uint64_t>(v)));
+          Eigen::Vector3d y;
+          Candidate& cd = cand[static_cast<size_t>(i)];
+          if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
+            cd.x = y;
+            cd.dist = (y - st.S.row(v).transpose()).norm();
+            cd.moved = true;
+          }
+        });
+        for (int i : cls) {
+          const int v = active[static_cast<size_t>(i)];
+          credit[static_cast<size_t>(v)] = 0;  // evaluated at the current neighbourhood
+          const Candidate& cd = cand[static_cast<size_t>(i)];
+          if (!cd.moved) continue;
+          st.S.row(v) = cd.x.transpose();
+          for (int f : st.vf[static_cast<size_t>(v)])
+            for (int k = 0; k < 3; ++k) {
+              const int w = st.F[static_cast<size_t>(f)][k];
+              if (w == v) continue;
+              credit[static_cast<size_t>(w)] += 0.3 * cd.dist / 2.0;
+              if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {
+                listed_in[static_cast<size_t>(w)] = round;
+                next.push_back(w);
+              }
+            }
+        }
+      }
+      keep.assign(next.size(), 0);
+      workers.parallel_for(static_cast<int>(next.size()), 64, 256, [&](int j, int) {
+        const int v = next[static_cast<size_t>(j)];
+        keep[static_cast<size_t>(j)] = credit[static_cast<size_t>(v)] > activity_tol(v) ? 1 : 0;
+      });
+      active.clear();
+      for (size_t j = 0; j < next.size(); ++j)
+        if (keep[j]) active.push_back(next[j]);
+      std::sort(active.begin(), active.end());
+      continue;
+    }
     const int na = static_cast<int>(active.size());
     cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
     // Candidates are computed from the same positions by every thread: results do not
@@ -531,8 +632,8 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       const std::uint64_t key =
           mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
       Eigen::Vector3d y;
+      Candidate& c = cand[static_cast<size_t>(i)];
       if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
-        Candidate& c = cand[static_cast<size_t>(i)];
         c.x = y;
         c.dist = (y - st.S.row(v).transpose()).norm();
         c.moved = true;
@@ -575,10 +676,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       const int v = active[static_cast<size_t>(i)];
       if (locked_in[static_cast<size_t>(v)] != round) credit[static_cast<size_t>(v)] = 0;  // moved, or converged
     }
-    // Activity threshold: absolute (the reference's movetol), or relative to the vertex's
-    // shortest chord to a neighbour, so that convergence is judged at the scale of the local
-    // triangles: coarse levels stop sooner, compressed regions (thin legs) are refined longer.
-    // Judged in parallel (a ring walk per vertex) into per-slot flags.
+    // Activity (activity_tol) judged in parallel (a ring walk per vertex) into per-slot flags.
     // An active vertex that was locked (its move not applied) stays active; a neighbour of a
     // mover joins only if its credit is above the threshold.
     keep.assign(next.size(), 0);
@@ -588,18 +686,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
         keep[static_cast<size_t>(j)] = 1;
         return;
       }
-      double tol = s.movetol;
-      if (s.movetol_rel > 0) {
-        double shortest = kInf;
-        const Eigen::Vector3d x = st.S.row(v).transpose();
-        for (int f : st.vf[static_cast<size_t>(v)])
-          for (int k = 0; k < 3; ++k) {
-            const int w = st.F[static_cast<size_t>(f)][k];
-            if (w != v) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
-          }
-        tol = std::min(s.movetol, s.movetol_rel * shortest);
-      }
-      keep[static_cast<size_t>(j)] = credit[static_cast<size_t>(v)] > tol ? 1 : 0;
+      keep[static_cast<size_t>(j)] = credit[static_cast<size_t>(v)] > activity_tol(v) ? 1 : 0;
     });
     active.clear();
     for (size_t j = 0; j < next.size(); ++j)

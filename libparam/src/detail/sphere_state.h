@@ -65,6 +65,7 @@ struct OptimizerSettings {
   std::uint64_t seed = 1;
   int threads = 0;             ///< 0 = hardware concurrency
   int max_rounds = 2000;       ///< safety cap on rounds per pass
+  bool coloured_rounds = false;  ///< rounds as colour classes (every computed move applied) instead of one greedy independent set
 };
 
 OptimizerSettings settings_for_effort(int effort);

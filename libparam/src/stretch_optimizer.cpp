@@ -542,6 +542,20 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
     }
     return tol;
   };
+  // The move of active[i] from the current positions into cand[i]; its random direction
+  // depends on (pass, round, vertex) only.
+  auto compute_candidate = [&](int i, int round, int thread) {
+    const int v = active[static_cast<size_t>(i)];
+    const std::uint64_t key =
+        mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
+    Eigen::Vector3d y;
+    Candidate& c = cand[static_cast<size_t>(i)];
+    if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
+      c.x = y;
+      c.dist = (y - st.S.row(v).transpose()).norm();
+      c.moved = true;
+    }
+  };
   int round = 0;
   for (; round < s.max_rounds && !active.empty(); ++round) {
     if (keep_going && !keep_going()) return -1;
@@ -581,19 +595,8 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
         cls.clear();
         for (int i = 0; i < na; ++i)
           if (colour[static_cast<size_t>(i)] == c) cls.push_back(i);
-        workers.parallel_for(static_cast<int>(cls.size()), 16, 64, [&](int j, int thread) {
-          const int i = cls[static_cast<size_t>(j)];
-          const int v = active[static_cast<size_t>(i)];
-          const std::uint64_t key = mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL +
-                                                       static_cast<std::uint64_t>(v)));
-          Eigen::Vector3d y;
-          Candidate& cd = cand[static_cast<size_t>(i)];
-          if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
-            cd.x = y;
-            cd.dist = (y - st.S.row(v).transpose()).norm();
-            cd.moved = true;
-          }
-        });
+        workers.parallel_for(static_cast<int>(cls.size()), 16, 64,
+                             [&](int j, int thread) { compute_candidate(cls[static_cast<size_t>(j)], round, thread); });
         for (int i : cls) {
           const int v = active[static_cast<size_t>(i)];
           credit[static_cast<size_t>(v)] = 0;  // evaluated at the current neighbourhood
@@ -627,18 +630,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
     cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
     // Candidates are computed from the same positions by every thread: results do not
     // depend on the thread count or scheduling.
-    workers.parallel_for(na, 16, 64, [&](int i, int thread) {
-      const int v = active[static_cast<size_t>(i)];
-      const std::uint64_t key =
-          mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
-      Eigen::Vector3d y;
-      Candidate& c = cand[static_cast<size_t>(i)];
-      if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
-        c.x = y;
-        c.dist = (y - st.S.row(v).transpose()).norm();
-        c.moved = true;
-      }
-    });
+    workers.parallel_for(na, 16, 64, [&](int i, int thread) { compute_candidate(i, round, thread); });
     // Apply greedily as an independent set, largest displacement first (ties by id).
     order.clear();
     for (int i = 0; i < na; ++i)

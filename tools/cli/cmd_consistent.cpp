@@ -31,11 +31,13 @@ int run_consistent(const ConsistentArgs& a) {
   job.options.constrained = a.flags.resolve(a.sphere);
   job.options.threads = a.sphere.threads;
   ProgressRenderer progress(a.quiet);
-  // Said before the minutes of work start (the summary comes at the end).
+  // Said before the minutes of work start (the summary comes at the end), on standard output:
+  // standard error holds progress and, on failure, the one error line.
   if (!a.quiet)
-    std::fprintf(stderr, "consistent parameterization of %s into %s\n",
+    std::printf("consistent parameterization of %s into %s\n",
                  job.meshes.empty() ? "the built-in samples" : (std::to_string(job.meshes.size()) + " meshes").c_str(),
                  job.output.c_str());
+  std::fflush(stdout);
   auto r = [&] {
     ComputeScope graceful_cancel;
     return pipeline::make_collection(job, progress.callback(), [] { return !cancel_requested(); });

@@ -46,6 +46,7 @@ void register_run(CLI::App& app);      // cmd_run.cpp:     the main job: check +
 void register_convert(CLI::App& app);  // cmd_convert.cpp: sphere map -> octahedral geometry image (EXR)
 void register_consistent(CLI::App& app);  // cmd_consistent.cpp: consistent collection + add
 void register_correspond(CLI::App& app);  // cmd_correspond.cpp: point transfer and its error
+void register_landmarks(CLI::App& app);   // cmd_landmarks.cpp:  proposed corresponding landmarks
 void register_transfer(CLI::App& app);    // cmd_transfer.cpp: colours/normals/uv/texture A -> B
 void register_morph(CLI::App& app);       // cmd_morph.cpp:    morph sequence between two members
 void register_pca(CLI::App& app);         // cmd_pca.cpp:      mean shape, components, errors, compression

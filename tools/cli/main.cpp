@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   cli::register_convert(app);
   cli::register_consistent(app);
   cli::register_correspond(app);
+  cli::register_landmarks(app);
   cli::register_transfer(app);
   cli::register_morph(app);
   cli::register_pca(app);

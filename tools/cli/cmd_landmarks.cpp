@@ -1,0 +1,76 @@
+// `spherekit landmarks`: corresponding landmarks proposed for a set of meshes (issue 25).
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "spherekit/pipeline/landmarks.h"
+
+namespace spherekit::cli {
+namespace {
+
+struct LandmarksArgs {
+  pipeline::LandmarksJob job;
+  std::string report;
+  bool quiet = false;
+};
+
+int run_landmarks(const LandmarksArgs& a) {
+  if (Status s = require_output_folders({a.report}); !s.ok()) return print_error(s);
+  ProgressRenderer progress(a.quiet);
+  auto r = [&] {
+    ComputeScope graceful_cancel;
+    return pipeline::propose_landmark_files(a.job, progress.callback());
+  }();
+  progress.finish();
+  if (cancel_requested()) return print_error(cancelled_status());
+  if (!r.ok()) return print_error(r.status());
+  if (!a.report.empty())
+    if (Status s = write_json_atomic(a.report, pipeline::to_json(a.job, *r)); !s.ok()) return print_error(s);
+  if (a.quiet) return 0;
+  const auto& p = r->proposal;
+  std::printf("%zu landmarks (%d extremities) on %zu meshes, %.2f s\n", p.names.size(), p.extremities,
+              a.job.meshes.size(), r->seconds);
+  for (std::size_t i = 0; i < a.job.meshes.size(); ++i) {
+    const auto& m = p.members[i];
+    double low = 1;
+    for (double c : p.confidence[i]) low = std::min(low, c);
+    std::printf("  %s -> %s: cost %.4f, lowest confidence %.2f%s%s%s\n", a.job.meshes[i].c_str(), r->files[i].c_str(),
+                m.cost, low, m.mirror_resolved ? ", mirror flip resolved by orientation" : "",
+                m.mirrored ? ", appears MIRRORED" : "", m.mirror_ambiguous ? ", left/right AMBIGUOUS: check on the page" : "");
+  }
+  return 0;
+}
+
+}  // namespace
+
+void register_landmarks(CLI::App& app) {
+  auto args = std::make_shared<LandmarksArgs>();
+  CLI::App* cmd = add_command(
+      app, "landmarks", "Propose corresponding landmarks for a set of meshes (NAME.lm.txt files)",
+      "Finds the extremities of every mesh (maxima of the average geodesic distance: limb tips,\n"
+      "head, tail, ears), matches them across the meshes by their pairwise geodesic distances\n"
+      "(normalised by sqrt(area)), resolves left/right mirror flips by the orientation of matched\n"
+      "triples, optionally adds --extra-points further points (farthest-point sampling, located by\n"
+      "their distances to the matched ones), and writes one `NAME.lm.txt` per mesh (beside it, or\n"
+      "in --output-dir), the format `consistent` reads. --report writes every match's confidence;\n"
+      "members whose left/right cannot be told are flagged there and in the summary.",
+      "  spherekit landmarks cats/*.obj --report landmarks.json\n"
+      "  spherekit landmarks a.obj b.obj c.obj --output-dir lm --extra-points 6\n"
+      "  spherekit consistent -o coll a.obj b.obj c.obj --features lm/a.lm.txt lm/b.lm.txt lm/c.lm.txt");
+  cmd->add_option("MESH", args->job.meshes, "input meshes (the first is the reference)")->required();
+  cmd->add_option("--output-dir", args->job.output_dir, "write the .lm.txt files here (default: beside each mesh)");
+  cmd->add_option("--report", args->report, "also write a JSON report here ('-': standard output)");
+  cmd->add_flag("-q,--quiet", args->quiet, "print neither progress nor the summary (errors still)");
+  auto& o = args->job.options;
+  cmd->add_option("--extra-points", o.extra_points, "further points by farthest-point sampling")->check(CLI::Range(0, 1000));
+  cmd->add_option("--max-extremities", o.max_extremities, "at most this many extremities per mesh")->check(CLI::Range(3, 16));
+  cmd->add_option("--agd-sources", o.agd_sources, "sources of the average-geodesic-distance estimate")->check(CLI::Range(4, 1000));
+  cmd->add_option("--extremity-radius", o.extremity_radius, "an extremity dominates this geodesic disc (x sqrt(area))")
+      ->check(CLI::Range(0.001, 0.999));
+  cmd->callback([args] { set_exit_code(run_landmarks(*args)); });
+}
+
+}  // namespace spherekit::cli

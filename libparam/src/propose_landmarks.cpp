@@ -4,6 +4,7 @@
 #include "spherekit/propose_landmarks.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -50,6 +51,24 @@ Result<MeshGraph> build_graph(const TriMesh& m, int index) {
   for (int v = 0; v < n; ++v) {
     const double l = g.N.row(v).norm();
     if (l > 0) g.N.row(v) /= l;
+  }
+  // Shortcuts across each pair of adjacent faces (the two vertices opposite an edge): an edge
+  // graph alone overestimates geodesics by up to ~8% depending on the connectivity, which
+  // differs between members; the extra chords cut that metrication error severalfold.
+  {
+    std::vector<std::array<int, 3>> half;  // (min, max, opposite) per face corner's opposite edge
+    half.reserve(m.F.rows() * 3);
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) {
+        const int a = m.F(f, (c + 1) % 3), b = m.F(f, (c + 2) % 3);
+        half.push_back({std::min(a, b), std::max(a, b), m.F(f, c)});
+      }
+    std::sort(half.begin(), half.end());
+    for (std::size_t i = 0; i + 1 < half.size(); ++i)
+      if (half[i][0] == half[i + 1][0] && half[i][1] == half[i + 1][1] && half[i][2] != half[i + 1][2]) {
+        edges.emplace_back(half[i][2], half[i + 1][2]);
+        edges.emplace_back(half[i + 1][2], half[i][2]);
+      }
   }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
@@ -148,37 +167,35 @@ Status find_extremities(const TriMesh& mesh, int index, const ProposeLandmarksOp
   return Status::ok_status();
 }
 
-// Signed turn at point a from the direction towards b to the direction towards c about the
-// outward normal, weighted by |sin| of the angle (0 when the directions coincide, as at a limb
-// tip from which every path leaves along the limb). Directions are taken where the shortest
-// path from a leaves a disc of radius r, which averages out the edge graph's zig-zag.
-double turn(const TriMesh& mesh, const Member& m, int ia, int a, int vb, int vc) {
-  constexpr double r = 0.1;  // x sqrt(area): beyond the tip's cone, well inside a limb's length
-  auto exit_point = [&](int v) {
-    while (m.parent[ia][v] >= 0 && m.dist[ia][v] > r) v = m.parent[ia][v];
-    return v;
-  };
-  const Eigen::Vector3d p = mesh.V.row(a), n = m.g.N.row(a);
-  Eigen::Vector3d tb = mesh.V.row(exit_point(vb)).transpose() - p, tc = mesh.V.row(exit_point(vc)).transpose() - p;
-  tb -= n * n.dot(tb);
-  tc -= n * n.dot(tc);
-  const double l = tb.norm() * tc.norm();
-  return l > 0 ? tb.cross(tc).dot(n) / l : 0.0;
-}
-
-// Orientation of every triple (i<j<k) of a member's points i (indices into m.dist).
-std::vector<double> triple_turns(const TriMesh& mesh, const Member& m, const std::vector<int>& pts,
-                                 const std::vector<int>& field) {
+// Orientation of every triple (i<j<k) of a member's points: seen from a centre vertex c, the
+// directions towards the three points turn counter-clockwise about the outward
+// normal (> 0) or clockwise (< 0). The value is the signed area of the triangle of the three
+// unit directions, so nearly coincident directions weigh little. Directions are taken where
+// the shortest path from the centre leaves a disc of radius 0.1 sqrt(area) (beyond the edge
+// graph's zig-zag, well inside a limb's length). Turning at the points themselves fails: every
+// path from a limb tip leaves along the limb. The centre must be the same surface point on
+// every member (seen from the antipode of a point, every cyclic order reverses): the
+// reference's AGD minimum, located on a member through the assignment being judged.
+std::vector<double> triple_turns(const TriMesh& mesh, const Member& m, const std::vector<int>& pts, int c) {
+  constexpr double r = 0.1;
+  std::vector<double> d;
+  std::vector<int> parent;
+  dijkstra(m.g, c, d, &parent);
+  const Eigen::Vector3d p = mesh.V.row(c), n = m.g.N.row(c);
   const int k = static_cast<int>(pts.size());
+  std::vector<Eigen::Vector3d> dir(k);
+  for (int i = 0; i < k; ++i) {
+    int v = pts[i];
+    while (parent[v] >= 0 && d[v] > r) v = parent[v];
+    Eigen::Vector3d t = mesh.V.row(v).transpose() - p;
+    t -= n * n.dot(t);
+    dir[i] = t.norm() > 0 ? Eigen::Vector3d(t.normalized()) : Eigen::Vector3d::Zero();
+  }
   std::vector<double> t(static_cast<std::size_t>(k) * k * k, 0.0);
   for (int i = 0; i < k; ++i)
     for (int j = i + 1; j < k; ++j)
-      for (int l = j + 1; l < k; ++l) {
-        // The same cyclic order seen from each corner: one vote each.
-        const double w = turn(mesh, m, field[i], pts[i], pts[j], pts[l]) + turn(mesh, m, field[j], pts[j], pts[l], pts[i]) +
-                         turn(mesh, m, field[l], pts[l], pts[i], pts[j]);
-        t[(static_cast<std::size_t>(i) * k + j) * k + l] = w / 3;
-      }
+      for (int l = j + 1; l < k; ++l)
+        t[(static_cast<std::size_t>(i) * k + j) * k + l] = 0.5 * (dir[j] - dir[i]).cross(dir[l] - dir[i]).dot(n);
   return t;
 }
 
@@ -193,8 +210,9 @@ struct Assignment {
 // some member) does not force a wrong one. Keeps the `keep` cheapest complete assignments.
 class Matcher {
  public:
-  Matcher(const std::vector<std::vector<double>>& R, const std::vector<std::vector<double>>& M, int keep)
-      : R_(R), M_(M), keep_(keep), kr_(static_cast<int>(R.size())), km_(static_cast<int>(M.size())) {}
+  Matcher(const std::vector<std::vector<double>>& R, const std::vector<std::vector<double>>& M,
+          const std::vector<double>& agd_r, const std::vector<double>& agd_m, int keep)
+      : R_(R), M_(M), agd_r_(agd_r), agd_m_(agd_m), keep_(keep), kr_(static_cast<int>(R.size())), km_(static_cast<int>(M.size())) {}
   std::vector<Assignment> run() {
     cur_.assign(kr_, -1);
     used_.assign(km_, false);
@@ -204,7 +222,7 @@ class Matcher {
     });
     return best_;
   }
-  static constexpr double kCap = 0.1;  // x sqrt(area): beyond this a pair is simply "wrong"
+  static constexpr double kCap = 0.25;  // x sqrt(area): beyond this a pair is simply "wrong"
 
  private:
   double bound() const { return static_cast<int>(best_.size()) < keep_ ? kInf : best_.back().cost; }
@@ -220,7 +238,9 @@ class Matcher {
     std::vector<std::pair<double, int>> opts;
     for (int j = -1; j < km_; ++j) {
       if (j >= 0 && used_[j]) continue;
-      double add = 0;
+      // The point's own AGD (isometry-invariant like the distances) tells a head from a limb tip
+      // at similar distances; weighted as one more pair.
+      double add = j < 0 ? kCap : std::min(std::abs(agd_r_[i] - agd_m_[j]), kCap);
       for (int p = 0; p < i; ++p)
         add += (j < 0 || cur_[p] < 0) ? kCap : std::min(std::abs(R_[i][p] - M_[j][cur_[p]]), kCap);
       opts.emplace_back(add, j);
@@ -236,6 +256,8 @@ class Matcher {
   }
   const std::vector<std::vector<double>>& R_;
   const std::vector<std::vector<double>>& M_;
+  const std::vector<double>& agd_r_;
+  const std::vector<double>& agd_m_;
   int keep_, kr_, km_;
   long nodes_ = 0;
   std::vector<int> cur_;
@@ -249,6 +271,12 @@ std::vector<std::vector<double>> pair_distances(const Member& m) {
   for (int i = 0; i < k; ++i)
     for (int j = 0; j < k; ++j) D[i][j] = m.dist[i][m.ext[j]];
   return D;
+}
+
+std::vector<double> ext_agd(const Member& m) {
+  std::vector<double> a;
+  for (int e : m.ext) a.push_back(m.agd[e]);
+  return a;
 }
 
 // Agreement -1..1 of the turns of the matched triples of the reference and the member.
@@ -273,61 +301,61 @@ double orientation_agreement(const std::vector<double>& tr, const std::vector<do
   return den > 0 ? num / den : 0.0;
 }
 
-}  // namespace
+struct MatchAll {
+  std::vector<LandmarkMemberMatch> members;
+  std::vector<std::vector<int>> to;  // per member: reference extremity -> member extremity (-1: none)
+  double total = 0;                  // sum of the members' mean costs
+};
 
-Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& meshes, const ProposeLandmarksOptions& o,
-                                                 const ProgressFn& progress) {
-  using R = Result<ProposeLandmarksResult>;
+// Every member matched to the reference `ref` (which has at least 3 extremities).
+MatchAll match_all(const std::vector<TriMesh>& meshes, const std::vector<Member>& mem, int ref) {
   const int nm = static_cast<int>(meshes.size());
-  if (nm < 1) return R(ErrorCode::InvalidArgument, "propose_landmarks: no meshes");
-  if (o.agd_sources < 4 || o.agd_sources > 1000) return R(ErrorCode::InvalidArgument, "agd_sources must be 4..1000");
-  if (o.max_extremities < 3 || o.max_extremities > 16) return R(ErrorCode::InvalidArgument, "max_extremities must be 3..16");
-  if (!(o.extremity_radius > 0 && o.extremity_radius < 1)) return R(ErrorCode::InvalidArgument, "extremity_radius must be in (0, 1)");
-  if (o.extra_points < 0 || o.extra_points > 1000) return R(ErrorCode::InvalidArgument, "extra_points must be 0..1000");
-  if (o.reference < 0 || o.reference >= nm) return R(ErrorCode::InvalidArgument, "reference out of range");
-
-  std::vector<Member> mem(nm);
-  for (int i = 0; i < nm; ++i) {
-    auto g = build_graph(meshes[i], i);
-    if (!g.ok()) return g.status();
-    mem[i].g = std::move(*g);
-    if (Status s = find_extremities(meshes[i], i, o, mem[i]); !s.ok()) return s;
-    if (!report_progress(progress, "landmarks", i, 0.5 * (i + 1) / nm)) return R(ErrorCode::Cancelled, "cancelled");
-  }
-  const int ref = o.reference;
-  Member& rm = mem[ref];
+  const Member& rm = mem[ref];
   const int kr = static_cast<int>(rm.ext.size());
-  if (kr < 3) return R(ErrorCode::InvalidInput, "mesh " + std::to_string(ref) + ": fewer than 3 extremities found");
   std::vector<int> ref_fields(kr);
   std::iota(ref_fields.begin(), ref_fields.end(), 0);
   const auto Rd = pair_distances(rm);
-  const auto Rt = triple_turns(meshes[ref], rm, rm.ext, ref_fields);
+  const int rc = static_cast<int>(std::min_element(rm.agd.begin(), rm.agd.end()) - rm.agd.begin());
+  const auto Rt = triple_turns(meshes[ref], rm, rm.ext, rc);
 
-  ProposeLandmarksResult out;
-  out.members.resize(nm);
-  for (int i = 0; i < nm; ++i) out.extremities_found.push_back(static_cast<int>(mem[i].ext.size()));
-  std::vector<std::vector<int>> to(nm);  // per member: reference extremity -> member extremity
-  to[ref] = ref_fields;
+  MatchAll ma;
+  ma.members.resize(nm);
+  ma.to.assign(nm, {});
+  ma.to[ref] = ref_fields;
   for (int i = 0; i < nm; ++i) {
     if (i == ref) continue;
-    Member& m = mem[i];
+    const Member& m = mem[i];
     const int km = static_cast<int>(m.ext.size());
-    std::vector<int> fields(km);
-    std::iota(fields.begin(), fields.end(), 0);
-    const auto Mt = triple_turns(meshes[i], m, m.ext, fields);
-    auto cands = Matcher(Rd, pair_distances(m), 64).run();
-    const double pairs = kr * (kr - 1) / 2.0;
+    auto cands = Matcher(Rd, pair_distances(m), ext_agd(rm), ext_agd(m), 64).run();
+    const double pairs = kr * (kr + 1) / 2.0;  // the pairs and the unary AGD terms
     // The cheapest assignment turning each way; a shape and its mirror image have the same
     // distances, so for a (near-)symmetric shape both are among the cheapest.
     const Assignment* pos = nullptr;
     const Assignment* neg = nullptr;
     double opos = 0, oneg = 0;
+    std::vector<std::pair<int, std::vector<double>>> turns_by_centre;  // a centre's turns, computed once
     for (const auto& a : cands) {
-      const double ag = orientation_agreement(Rt, Mt, kr, km, a.to);
+      if (pos && neg) break;  // only the cheapest of each orientation is used
+      // The reference's centre on this member: the vertex whose distances to the assigned
+      // extremities best fit the reference centre's (geodesic trilateration).
+      int c = 0;
+      double best = kInf;
+      for (int v = 0; v < static_cast<int>(m.agd.size()); ++v) {
+        double e = 0;
+        for (int q = 0; q < kr && e < best; ++q)
+          if (a.to[q] >= 0) e += std::pow(m.dist[a.to[q]][v] - rm.dist[q][rc], 2);
+        if (e < best) best = e, c = v;
+      }
+      auto it = std::find_if(turns_by_centre.begin(), turns_by_centre.end(), [&](const auto& t) { return t.first == c; });
+      if (it == turns_by_centre.end()) {
+        turns_by_centre.emplace_back(c, triple_turns(meshes[i], m, m.ext, c));
+        it = turns_by_centre.end() - 1;
+      }
+      const double ag = orientation_agreement(Rt, it->second, kr, km, a.to);
       if (ag >= 0 && !pos) pos = &a, opos = ag;
       if (ag < 0 && !neg) neg = &a, oneg = ag;
     }
-    LandmarkMemberMatch& mm = out.members[i];
+    LandmarkMemberMatch& mm = ma.members[i];
     // Two assignments are "about as good" when their mean pair error differs by less than
     // 0.01 sqrt(area): the size of the AGD maxima's placement noise between poses.
     const double close = 0.01 * pairs;
@@ -350,9 +378,56 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     const double other = pick == pos ? (neg ? neg->cost : kInf) : (pos ? pos->cost : kInf);
     if (std::abs(mm.orientation_agreement) < 0.3 && other - pick->cost < close) mm.mirror_ambiguous = true;
     if (mm.mirrored && other - pick->cost < close) mm.mirror_ambiguous = true;
-    to[i] = pick->to;
-    if (!report_progress(progress, "landmarks", i, 0.5 + 0.4 * (i + 1) / nm)) return R(ErrorCode::Cancelled, "cancelled");
+    ma.to[i] = pick->to;
+    ma.total += mm.cost;
   }
+  return ma;
+}
+
+}  // namespace
+
+Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& meshes, const ProposeLandmarksOptions& o,
+                                                 const ProgressFn& progress) {
+  using R = Result<ProposeLandmarksResult>;
+  const int nm = static_cast<int>(meshes.size());
+  if (nm < 1) return R(ErrorCode::InvalidArgument, "propose_landmarks: no meshes");
+  if (o.agd_sources < 4 || o.agd_sources > 1000) return R(ErrorCode::InvalidArgument, "agd_sources must be 4..1000");
+  if (o.max_extremities < 3 || o.max_extremities > 16) return R(ErrorCode::InvalidArgument, "max_extremities must be 3..16");
+  if (!(o.extremity_radius > 0 && o.extremity_radius < 1)) return R(ErrorCode::InvalidArgument, "extremity_radius must be in (0, 1)");
+  if (o.extra_points < 0 || o.extra_points > 1000) return R(ErrorCode::InvalidArgument, "extra_points must be 0..1000");
+  if (o.reference < -1 || o.reference >= nm) return R(ErrorCode::InvalidArgument, "reference out of range");
+
+  std::vector<Member> mem(nm);
+  for (int i = 0; i < nm; ++i) {
+    auto g = build_graph(meshes[i], i);
+    if (!g.ok()) return g.status();
+    mem[i].g = std::move(*g);
+    if (Status s = find_extremities(meshes[i], i, o, mem[i]); !s.ok()) return s;
+    if (!report_progress(progress, "landmarks", i, 0.5 * (i + 1) / nm)) return R(ErrorCode::Cancelled, "cancelled");
+  }
+  // The reference: given, or the member that matches the others best (a member that is an
+  // outlier of the family, e.g. in a different body shape, makes every match worse).
+  int ref = o.reference;
+  MatchAll ma;
+  if (ref >= 0) {
+    if (mem[ref].ext.size() < 3) return R(ErrorCode::InvalidInput, "mesh " + std::to_string(ref) + ": fewer than 3 extremities found");
+    ma = match_all(meshes, mem, ref);
+  } else {
+    for (int r = 0; r < std::min(nm, 8); ++r) {  // 8 candidates bound the cost at 8 n matches
+      if (mem[r].ext.size() < 3) continue;
+      MatchAll c = match_all(meshes, mem, r);
+      if (ref < 0 || c.total < ma.total) ma = std::move(c), ref = r;
+      if (!report_progress(progress, "landmarks", r, 0.5 + 0.4 * (r + 1) / std::min(nm, 8))) return R(ErrorCode::Cancelled, "cancelled");
+    }
+    if (ref < 0) return R(ErrorCode::InvalidInput, "no mesh has 3 extremities");
+  }
+  Member& rm = mem[ref];
+  const int kr = static_cast<int>(rm.ext.size());
+  ProposeLandmarksResult out;
+  out.reference = ref;
+  out.members = ma.members;
+  for (int i = 0; i < nm; ++i) out.extremities_found.push_back(static_cast<int>(mem[i].ext.size()));
+  const std::vector<std::vector<int>>& to = ma.to;
 
   // Names: the reference's extremities matched on every member, in decreasing AGD.
   std::vector<int> keep;

@@ -53,7 +53,7 @@ Result<LandmarksResult> propose_landmark_files(const LandmarksJob& job, const Pr
 Json to_json(const LandmarksJob& job, const LandmarksResult& r) {
   const ProposeLandmarksResult& p = r.proposal;
   Json j;
-  j["reference"] = job.meshes.at(job.options.reference);
+  j["reference"] = job.meshes.at(static_cast<std::size_t>(p.reference));
   j["names"] = p.names;
   j["extremities"] = p.extremities;
   j["options"] = {{"agd_sources", job.options.agd_sources},

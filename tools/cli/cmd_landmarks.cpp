@@ -60,7 +60,7 @@ void register_landmarks(CLI::App& app) {
       "  spherekit landmarks cats/*.obj --report landmarks.json\n"
       "  spherekit landmarks a.obj b.obj c.obj --output-dir lm --extra-points 6\n"
       "  spherekit consistent -o coll a.obj b.obj c.obj --features lm/a.lm.txt lm/b.lm.txt lm/c.lm.txt");
-  cmd->add_option("MESH", args->job.meshes, "input meshes (the first is the reference)")->required();
+  cmd->add_option("MESH", args->job.meshes, "input meshes")->required();
   cmd->add_option("--output-dir", args->job.output_dir, "write the .lm.txt files here (default: beside each mesh)");
   cmd->add_option("--report", args->report, "also write a JSON report here ('-': standard output)");
   cmd->add_flag("-q,--quiet", args->quiet, "print neither progress nor the summary (errors still)");

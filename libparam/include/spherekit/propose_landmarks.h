@@ -33,7 +33,7 @@ struct ProposeLandmarksOptions {
   int max_extremities = 10;      ///< at most this many extremities per member (3..16)
   double extremity_radius = 0.15;  ///< an extremity dominates the AGD on this geodesic disc (x sqrt(area))
   int extra_points = 0;          ///< further points by farthest-point sampling (>= 0)
-  int reference = 0;             ///< the member the others are matched to
+  int reference = -1;            ///< the member the others are matched to; -1: the one of the first 8 matching the others best
 };
 
 /// How one member was matched to the reference.
@@ -48,6 +48,7 @@ struct LandmarkMemberMatch {
 
 struct ProposeLandmarksResult {
   std::vector<std::string> names;               ///< lm0, lm1, ... (extremities first)
+  int reference = 0;                            ///< the member the others were matched to
   int extremities = 0;                          ///< how many of `names` are extremities
   std::vector<std::vector<Landmark>> landmarks; ///< per member, in the order of `names`
   std::vector<std::vector<double>> confidence;  ///< per member and name, 0..1 (1 for the reference)

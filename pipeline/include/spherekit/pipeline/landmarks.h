@@ -14,7 +14,7 @@
 namespace spherekit::pipeline {
 
 struct LandmarksJob {
-  std::vector<std::string> meshes;  ///< mesh files (the first is the reference unless options.reference says otherwise)
+  std::vector<std::string> meshes;  ///< mesh files
   std::string output_dir;           ///< where `NAME.lm.txt` go; empty: beside each mesh (where `consistent` looks)
   bool write = true;                ///< false: compute only (`run` writes into its own folder)
   ProposeLandmarksOptions options;

@@ -1,0 +1,124 @@
+// propose_landmarks: extremities matched across members, mirror flips resolved or flagged,
+// errors as values.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "sample_collection.h"
+#include "spherekit/propose_landmarks.h"
+#include "test_meshes.h"
+
+using namespace spherekit;
+
+namespace {
+
+TriMesh sample_member(int index) {
+  samples::SampleCollectionOptions o;
+  o.members = index + 1;
+  o.target_vertices = 2000;
+  auto c = samples::make_sample_collection(o);
+  REQUIRE(c.ok());
+  return (*c)[index].mesh;
+}
+
+// The same surface with its vertices renumbered by a fixed random permutation: a member with
+// different indices, so a match that only echoed indices would fail.
+TriMesh permuted(const TriMesh& m, std::vector<int>& perm) {
+  perm.resize(m.V.rows());
+  std::iota(perm.begin(), perm.end(), 0);
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(7));
+  TriMesh out = m;
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) out.V.row(perm[v]) = m.V.row(v);
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) out.F(f, c) = perm[m.F(f, c)];
+  return out;
+}
+
+// The mirror image (x -> -x), faces turned so that they face outward again.
+TriMesh mirrored(const TriMesh& m) {
+  TriMesh out = m;
+  out.V.col(0) *= -1;
+  out.F.col(1).swap(out.F.col(2));
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("propose_landmarks matches a renumbered copy vertex for vertex", "[param]") {
+  const TriMesh a = sample_member(0);
+  std::vector<int> perm;
+  const TriMesh b = permuted(a, perm);
+  ProposeLandmarksOptions o;
+  o.extra_points = 3;
+  o.reference = 0;
+  auto r = propose_landmarks({a, b}, o);
+  REQUIRE(r.ok());
+  REQUIRE(r->extremities >= 3);
+  REQUIRE(r->names.size() == static_cast<std::size_t>(r->extremities + 3));
+  REQUIRE(r->landmarks.size() == 2);
+  for (std::size_t k = 0; k < r->names.size(); ++k) {
+    CHECK(r->landmarks[0][k].name == r->names[k]);
+    CHECK(r->landmarks[1][k].name == r->names[k]);
+    // The same point up to the AGD estimate's noise (the first source depends on the numbering):
+    // within 3% of the bounding-box diagonal.
+    const double diag = (a.V.colwise().maxCoeff() - a.V.colwise().minCoeff()).norm();
+    CHECK((a.V.row(r->landmarks[0][k].vertex) - b.V.row(r->landmarks[1][k].vertex)).norm() < 0.03 * diag);
+    CHECK(r->confidence[1][k] > 0.9);
+  }
+  // Not exactly 0: the AGD's first farthest-point source depends on the numbering.
+  CHECK(r->members[1].cost < 0.01);
+  CHECK_FALSE(r->members[1].mirrored);
+  CHECK(r->members[1].orientation_agreement > 0.5);
+}
+
+TEST_CASE("propose_landmarks: a mirrored member's flip is resolved or flagged", "[param]") {
+  const TriMesh a = sample_member(1);
+  auto r = propose_landmarks({a, mirrored(a)}, ProposeLandmarksOptions{});
+  REQUIRE(r.ok());
+  const LandmarkMemberMatch& m = r->members[1];
+  // Vertex i of the copy is the mirror image of vertex i: the identity is the intrinsically
+  // perfect match, and it reverses orientation. Either orientation chose another (the shape's
+  // own left/right symmetry: resolved), or the member is reported as mirrored / ambiguous.
+  bool identity = true;
+  for (std::size_t k = 0; k < r->names.size(); ++k) identity = identity && r->landmarks[0][k].vertex == r->landmarks[1][k].vertex;
+  if (identity) CHECK((m.mirrored || m.mirror_ambiguous));
+  else CHECK(m.mirror_resolved);
+  CHECK((m.mirrored || m.mirror_ambiguous || m.mirror_resolved));
+}
+
+TEST_CASE("propose_landmarks finds the six tips of an octahedron-like blob", "[param]") {
+  // A sphere pulled out along the six axis directions: six extremities, no more.
+  TriMesh m = test::icosphere(4);
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+    Eigen::Vector3d p = m.V.row(v).transpose().normalized();
+    const double s = 1 + 1.5 * std::pow(p.cwiseAbs().maxCoeff(), 12);
+    m.V.row(v) = (p * s).transpose();
+  }
+  auto r = propose_landmarks({m}, ProposeLandmarksOptions{});
+  REQUIRE(r.ok());
+  CHECK(r->extremities == 6);
+  for (const auto& lm : r->landmarks[0]) CHECK(m.V.row(lm.vertex).norm() > 2.0);
+}
+
+TEST_CASE("propose_landmarks errors are values", "[param]") {
+  CHECK(propose_landmarks({}).status().code() == ErrorCode::InvalidArgument);
+  const TriMesh a = test::icosphere(2);
+  ProposeLandmarksOptions o;
+  o.max_extremities = 2;
+  CHECK(propose_landmarks({a}, o).status().code() == ErrorCode::InvalidArgument);
+  o = {};
+  o.reference = 3;
+  CHECK(propose_landmarks({a, a}, o).status().code() == ErrorCode::InvalidArgument);
+  auto two = propose_landmarks({a, test::two_tetrahedra()});
+  REQUIRE(two.status().code() == ErrorCode::InvalidInput);
+  CHECK(two.status().message().rfind("mesh 1:", 0) == 0);
+  TriMesh bad = a;
+  bad.F(0, 0) = 100000;
+  CHECK(propose_landmarks({bad}).status().code() == ErrorCode::InvalidInput);
+  int calls = 0;
+  auto cancelled = propose_landmarks({a, a}, {}, [&](const ProgressEvent&) { return ++calls < 2; });
+  CHECK(cancelled.status().code() == ErrorCode::Cancelled);
+}

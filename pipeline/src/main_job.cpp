@@ -1,6 +1,7 @@
 // run_main_job() (main_job.h): the main job composed in memory from the other jobs. What it
 // shows on the results page is described as JSON for write_site_page() (site_page.h).
 #include "spherekit/pipeline/main_job.h"
+#include "spherekit/pipeline/landmarks.h"
 
 #include <filesystem>
 #include <set>
@@ -30,6 +31,7 @@ bool MainJobObserver::keep_going() { return true; }
 void MainJobObserver::samples_written(const std::string&) {}
 void MainJobObserver::failed(const Status&) {}
 void MainJobObserver::heading(const std::string&) {}
+void MainJobObserver::note(const std::string&) {}
 void MainJobObserver::collection_made(const MakeCollectionResult&, const std::string&) {}
 void MainJobObserver::correspondence(const Json&) {}
 void MainJobObserver::assets_converted(const ConvertCollectionResult&) {}
@@ -272,12 +274,37 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
 
   // The consistent collection: the samples always (they share landmarks); user meshes when
   // there are at least two and each has its feature file beside it (NAME.lm.txt).
+  // Meshes without them get proposed landmarks (issue 25), written into OUT/landmarks/ (never
+  // beside the user's meshes), and the collection is made with those.
   bool collection = use_samples;
-  if (!use_samples && inputs.size() >= 2) {
+  std::vector<std::string> feature_files;
+  if (!use_samples && inputs.size() >= 2 && out.failed == 0) {
     collection = true;
+    bool all = true;
     for (const std::string& path : inputs) {
       const fs::path lm = fs::path(path).parent_path() / (stem_of(path) + ".lm.txt");
-      if (!fs::is_regular_file(lm, ec)) collection = false;
+      if (!fs::is_regular_file(lm, ec)) all = false;
+    }
+    if (!all) {
+      LandmarksJob lj;
+      lj.meshes = inputs;
+      lj.output_dir = (out_dir / "landmarks").string();
+      auto lr = propose_landmark_files(lj, observer.progress("landmarks"));
+      if (lr.status().code() == ErrorCode::Cancelled) return lr.status();
+      if (!lr.ok()) {
+        collection = false;
+        out.errors.push_back(lr.status());
+        observer.failed(lr.status());
+      } else {
+        feature_files = lr->files;
+        int flagged = 0;
+        for (const auto& m : lr->proposal.members) flagged += m.mirror_ambiguous || m.mirrored;
+        observer.note("the meshes came without feature files (NAME.lm.txt): proposed " +
+                      std::to_string(lr->proposal.names.size()) + " corresponding landmarks (as 'spherekit landmarks') in " +
+                      lj.output_dir + (flagged ? "; " + std::to_string(flagged) + " member(s) flagged left/right ambiguous or mirrored, see landmarks_report.json" : ""));
+        if (Status s = formats::write_file_atomic((out_dir / "landmarks_report.json").string(), to_json(lj, *lr).dump(2) + "\n"); !s.ok())
+          return s;
+      }
     }
   }
   if (collection && out.failed == 0) {
@@ -286,6 +313,7 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
     const std::string col_dir = (out_dir / "collection").string();
     MakeCollectionJob cj;
     cj.meshes = inputs;
+    cj.features = feature_files;
     cj.output = col_dir;
     cj.options.constrained.sphere = a.options;
     cj.options.threads = a.options.threads;

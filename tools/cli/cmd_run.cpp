@@ -39,6 +39,10 @@ class RunPrinter : public pipeline::MainJobObserver {
     finish();
     worst = worse_exit_code(worst, print_error(error));
   }
+  void note(const std::string& text) override {
+    finish();
+    std::fprintf(stderr, "spherekit: note: %s\n", text.c_str());
+  }
   void heading(const std::string& text) override {
     finish();
     if (!quiet_) std::printf("\n%s\n", text.c_str());

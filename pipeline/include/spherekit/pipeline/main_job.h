@@ -39,6 +39,9 @@ class MainJobObserver {
   virtual void failed(const Status& error);
   /// A stage starts ("Converting the collection (as 'spherekit convert --collection'):").
   virtual void heading(const std::string& text);
+  /// Something the user should know that is not an error (the CLI prints it on stderr), e.g.
+  /// that the meshes came without feature files and landmarks were proposed for them.
+  virtual void note(const std::string& text);
   virtual void collection_made(const MakeCollectionResult& result, const std::string& output);
   virtual void correspondence(const Json& measured);
   virtual void assets_converted(const ConvertCollectionResult& result);

@@ -1,0 +1,48 @@
+// `spherekit landmarks`: proposed landmark files that `check --landmarks` and `consistent`
+// read, the report, and the failure contract.
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <string>
+
+#include "cli_shorthands.h"
+#include "test_paths.h"
+
+using namespace spherekit::test;
+namespace fs = std::filesystem;
+
+TEST_CASE("landmarks: proposed files read back by check --landmarks, with a report", "[cli]") {
+  const std::string dir = temp_dir("landmarks_cli");
+  const std::string cap = temp_dir("landmarks_cli_capture");
+  REQUIRE(sk("samples -o " + q(dir) + " --members 2 --target-vertices 1500", cap).exit_code == 0);
+  const std::string a = dir + "/sample_a.obj", b = dir + "/sample_b.obj", out = dir + "/proposed";
+  auto r = sk("landmarks " + q(a) + " " + q(b) + " --output-dir " + q(out) + " --extra-points 2 --report " +
+                  q(dir + "/lm.json"),
+              cap);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  for (const std::string& m : {a, b}) {
+    const std::string lm = out + "/" + fs::path(m).stem().string() + ".lm.txt";
+    REQUIRE(fs::is_regular_file(lm));
+    CHECK(sk("check " + q(m) + " --landmarks " + q(lm), cap).exit_code == 0);
+  }
+  const auto j = read_json(dir + "/lm.json");
+  REQUIRE(j["members"].size() == 2);
+  const std::size_t names = j["names"].size();
+  CHECK(names == static_cast<std::size_t>(j["extremities"].get<int>()) + 2);
+  for (const auto& m : j["members"]) {
+    REQUIRE(m["landmarks"].size() == names);
+    for (const auto& l : m["landmarks"]) {
+      CHECK(l["confidence"].get<double>() >= 0);
+      CHECK(l["confidence"].get<double>() <= 1);
+    }
+  }
+}
+
+TEST_CASE("landmarks: a missing mesh is one error line naming it, nothing written", "[cli]") {
+  const std::string dir = temp_dir("landmarks_cli_bad");
+  const std::string cap = temp_dir("landmarks_cli_bad_capture");
+  REQUIRE(sk("samples -o " + q(dir) + " --members 1 --target-vertices 800", cap).exit_code == 0);
+  auto r = sk("landmarks " + q(dir + "/sample_a.obj") + " " + q(dir + "/nothere.obj") + " --output-dir " + q(dir + "/o"), cap);
+  require_failure(r, 4, "nothere.obj", "nothere.obj");
+  CHECK_FALSE(fs::exists(dir + "/o/sample_a.lm.txt"));
+}

@@ -292,9 +292,11 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
       auto lr = propose_landmark_files(lj, observer.progress("landmarks"));
       if (lr.status().code() == ErrorCode::Cancelled) return lr.status();
       if (!lr.ok()) {
+        // The user gave no features: without a proposal the meshes are mapped alone, as before,
+        // and the job has not failed.
         collection = false;
-        out.errors.push_back(lr.status());
-        observer.failed(lr.status());
+        observer.note("no corresponding landmarks could be proposed (" + lr.status().message() +
+                      "): each mesh is mapped alone; give NAME.lm.txt files for a consistent collection");
       } else {
         feature_files = lr->files;
         int flagged = 0;
@@ -330,7 +332,12 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
       col_status = formats::write_file_atomic((out_dir / "collection_report.json").string(), rep.dump(2) + "\n");
     }
     if (col_status.code() == ErrorCode::Cancelled) return col_status;
-    if (!col_status.ok()) {
+    if (!col_status.ok() && !feature_files.empty()) {
+      // Proposed landmarks (not the user's) did not give a collection: the per-mesh results
+      // stand and the job has not failed; say so, with the reason.
+      observer.note("the consistent collection with the proposed landmarks failed (" + col_status.message() +
+                    "); the per-mesh results stand; check the landmarks in " + (out_dir / "landmarks").string());
+    } else if (!col_status.ok()) {
       out.errors.push_back(col_status);
       observer.failed(col_status);
     } else {

@@ -46,3 +46,26 @@ TEST_CASE("landmarks: a missing mesh is one error line naming it, nothing writte
   require_failure(r, 4, "nothere.obj", "nothere.obj");
   CHECK_FALSE(fs::exists(dir + "/o/sample_a.lm.txt"));
 }
+
+// The main job on meshes without feature files proposes landmarks (OUT/landmarks/, never beside
+// the user's meshes), says so, and makes the consistent collection from them.
+TEST_CASE("run proposes landmarks for meshes that come without feature files", "[cli]") {
+  const std::string dir = temp_dir("landmarks_run");
+  const std::string cap = temp_dir("landmarks_run_capture");
+  REQUIRE(sk("samples -o " + q(dir + "/s") + " --members 2 --target-vertices 600", cap).exit_code == 0);
+  fs::create_directories(dir + "/in");
+  for (const char* m : {"sample_a.obj", "sample_b.obj"}) fs::copy_file(dir + "/s/" + m, dir + "/in/" + m);
+  const std::string out = dir + "/out";
+  auto r = sk("run " + q(dir + "/in/sample_a.obj") + " " + q(dir + "/in/sample_b.obj") + " -o " + q(out) +
+                  " --effort 0",
+              cap);
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.find("came without feature files") != std::string::npos);
+  for (const char* m : {"sample_a", "sample_b"}) {
+    CHECK(fs::is_regular_file(out + "/landmarks/" + std::string(m) + ".lm.txt"));
+    CHECK_FALSE(fs::exists(dir + "/in/" + std::string(m) + ".lm.txt"));
+    CHECK(fs::is_regular_file(out + "/collection/" + std::string(m) + ".sphere.obj"));
+  }
+  CHECK(read_json(out + "/landmarks_report.json")["members"].size() == 2);
+}

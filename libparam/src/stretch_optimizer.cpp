@@ -450,7 +450,6 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
   double e0 = ring_energy(st, ring, x, s.regularizer_weight, s.split_distance);
   if (!std::isfinite(e0)) e0 = std::numeric_limits<double>::max();
   double ecur = e0;
-
   bool improved = false;
   if (s.newton) {
     // Newton steps first; a random-direction search only where Newton cannot proceed
@@ -524,7 +523,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   // proportion to its active vertices, not to the mesh (late rounds have a few dozen).
   std::vector<int> locked_in(static_cast<size_t>(nv), -1), listed_in(static_cast<size_t>(nv), -1);
   std::vector<int> order, next, keep, colour;
-  std::vector<int> colour_of(static_cast<size_t>(nv), -1);
+  std::vector<int> colour_of(static_cast<size_t>(nv), -1), class_start;
   // Activity threshold: absolute (the reference's movetol), or relative to the vertex's
   // shortest chord to a neighbour, so that convergence is judged at the scale of the local
   // triangles: coarse levels stop sooner, compressed regions (thin legs) are refined longer.
@@ -569,8 +568,10 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       const int na = static_cast<int>(active.size());
       colour.assign(active.size(), 0);
       int ncol = 0;
-      for (int i = 0; i < na; ++i) colour_of[static_cast<size_t>(active[static_cast<size_t>(i)])] = -1;
-      for (int i = 0; i < na; ++i) listed_in[static_cast<size_t>(active[static_cast<size_t>(i)])] = round;
+      for (int i = 0; i < na; ++i) {
+        colour_of[static_cast<size_t>(active[static_cast<size_t>(i)])] = -1;
+        listed_in[static_cast<size_t>(active[static_cast<size_t>(i)])] = round;
+      }
       for (int i = 0; i < na; ++i) {
         const int v = active[static_cast<size_t>(i)];
         std::uint64_t used = 0;
@@ -590,14 +591,20 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       cand.assign(active.size(), Candidate{Eigen::Vector3d::Zero(), 0.0, false});
       next.clear();
       for (int i = 0; i < na; ++i) next.push_back(active[static_cast<size_t>(i)]);
-      std::vector<int>& cls = order;
+      // The classes as consecutive runs of `order` (a counting sort: ascending slots in each).
+      class_start.assign(static_cast<size_t>(ncol) + 1, 0);
+      for (int i = 0; i < na; ++i) ++class_start[static_cast<size_t>(colour[static_cast<size_t>(i)]) + 1];
+      for (int c = 0; c < ncol; ++c) class_start[static_cast<size_t>(c) + 1] += class_start[static_cast<size_t>(c)];
+      order.resize(active.size());
+      for (int i = 0; i < na; ++i) order[static_cast<size_t>(class_start[static_cast<size_t>(colour[static_cast<size_t>(i)])]++)] = i;
+      for (int c = ncol; c > 0; --c) class_start[static_cast<size_t>(c)] = class_start[static_cast<size_t>(c) - 1];
+      class_start[0] = 0;
       for (int c = 0; c < ncol; ++c) {
-        cls.clear();
-        for (int i = 0; i < na; ++i)
-          if (colour[static_cast<size_t>(i)] == c) cls.push_back(i);
-        workers.parallel_for(static_cast<int>(cls.size()), 16, 64,
-                             [&](int j, int thread) { compute_candidate(cls[static_cast<size_t>(j)], round, thread); });
-        for (int i : cls) {
+        const int* cls = order.data() + class_start[static_cast<size_t>(c)];
+        const int count = class_start[static_cast<size_t>(c) + 1] - class_start[static_cast<size_t>(c)];
+        workers.parallel_for(count, 16, 64, [&](int j, int thread) { compute_candidate(cls[j], round, thread); });
+        for (int j = 0; j < count; ++j) {
+          const int i = cls[j];
           const int v = active[static_cast<size_t>(i)];
           credit[static_cast<size_t>(v)] = 0;  // evaluated at the current neighbourhood
           const Candidate& cd = cand[static_cast<size_t>(i)];

@@ -180,25 +180,21 @@ tinygltf::Value json_array(const std::vector<double>& xs) {
 tinygltf::Value json_object(tinygltf::Value::Object o) { return tinygltf::Value(std::move(o)); }
 
 tinygltf::Value quantization_json(const QuantizationChoice& choice, bool has_normals, bool has_texcoords) {
+  // What a user needs to know about the error the quantization adds; the grids themselves are
+  // in the Draco bitstream (and in the convert report). Kept short: the JSON is part of every
+  // level's size.
   const DracoQuantization& q = choice.quantization;
   tinygltf::Value::Object o;
   o["position_bits"] = json_int(q.position_bits);
-  o["position_origin"] = json_array({q.position_origin[0], q.position_origin[1], q.position_origin[2]});
-  o["position_range"] = json_number(q.position_range);
-  o["position_step"] = json_number(q.position_step());
   o["position_max_error"] = json_number(choice.position_max_error);
   tinygltf::Value::Object budget;
   budget["reference_rms_error"] = json_number(choice.reference_rms_error);
-  budget["position_error_fraction"] = json_number(choice.position_error_fraction);
-  budget["decided_by"] = json_string(choice.reference_rms_error > 0 ? "error budget" : "minimum bits");
+  budget["decided_by"] = json_string(choice.rate_distortion        ? "rate-distortion"
+                                     : choice.reference_rms_error > 0 ? "error budget"
+                                                                      : "minimum bits");
   o["budget"] = json_object(std::move(budget));
   if (has_normals) o["normal_bits"] = json_int(q.normal_bits);
-  if (has_texcoords) {
-    o["texcoord_bits"] = json_int(q.texcoord_bits);
-    o["texcoord_origin"] = json_array({q.texcoord_origin[0], q.texcoord_origin[1]});
-    o["texcoord_range"] = json_number(q.texcoord_range);
-    o["texcoord_step"] = json_number(q.texcoord_step());
-  }
+  if (has_texcoords) o["texcoord_bits"] = json_int(q.texcoord_bits);
   return json_object(std::move(o));
 }
 

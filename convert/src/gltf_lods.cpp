@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "gltf_document.h"
+#include "spherekit/convert/position_bits.h"
 #include "spherekit/convert/adaptive_lods.h"
 #include "spherekit/formats/atomic_file.h"
 
@@ -19,13 +20,14 @@ namespace spherekit::convert {
 namespace {
 
 // mesh.extras.spherekit of one level.
-tinygltf::Value level_extras(int level, int image_size, int texture_size, const QuantizationChoice& q, LodMode mode) {
+tinygltf::Value level_extras(int level, int image_size, int texture_size, const QuantizationChoice& q, LodMode mode,
+                             bool has_normals) {
   tinygltf::Value::Object o;
   o["lod"] = detail::json_int(level);
   o["lod_mode"] = detail::json_string(mode == LodMode::Adaptive ? "adaptive" : "uniform");
   o["geometry_image_size"] = detail::json_int(image_size);
   o["texture_size"] = detail::json_int(texture_size);
-  o["quantization"] = detail::quantization_json(q, true, true);
+  o["quantization"] = detail::quantization_json(q, has_normals, true);
   tinygltf::Value::Object extras;
   extras["spherekit"] = detail::json_object(std::move(o));
   return detail::json_object(std::move(extras));
@@ -38,9 +40,9 @@ tinygltf::Value asset_extras(const GltfLodOptions& options, int texture_size, in
   o["layout"] = detail::json_string("octahedral");
   o["geometry_image_size"] = detail::json_int(texture_size);
   o["levels"] = detail::json_int(levels);
-  o["texcoord"] = detail::json_string(
-      "TEXCOORD_0 = texel centre ((j + 0.5) / T, (i + 0.5) / T) of texel (row i, column j) of the T x T "
-      "geometry image, T = geometry_image_size; octahedral domain u = -1 + 2j/(T-1), v = -1 + 2i/(T-1)");
+  // The convention in brief (README, "glTF levels of detail"): each file carries it, but a
+  // level's JSON is part of its size, which is compared against other tools' files.
+  o["texcoord"] = detail::json_string("texel centre ((j+0.5)/T, (i+0.5)/T), T = geometry_image_size");
   return detail::provenance_json(std::move(o));
 }
 
@@ -103,8 +105,10 @@ std::vector<GltfMesh> adaptive_member_levels(std::vector<std::vector<GltfMesh>>&
   return meshes;
 }
 
+// `finest`: the finest remesh the levels were simplified from (adaptive); nullptr: level 0 is it.
 Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
-                                   const GltfLodOptions& options, const ProgressFn& progress);
+                                   const GltfLodOptions& options, const ProgressFn& progress,
+                                   const TriMesh* finest = nullptr);
 
 }  // namespace
 
@@ -117,9 +121,12 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
     a.lod0_vertex_fraction = options.lod0_vertex_fraction;
     a.drop_hole_faces = options.drop_hole_faces;  // exactly, by the simplifier's rim constraint
     SPHEREKIT_ASSIGN_OR_RETURN(auto all, adaptive_lod_meshes({image}, a, progress));
+    // The surface the levels approximate: with the holes open when the levels leave them out
+    // (else the hole faces' distance to the level would count as its error).
+    const TriMesh finest = options.drop_hole_faces ? geometry_image_open_mesh(image) : geometry_image_mesh(image);
     return build_from_meshes(adaptive_member_levels(all, 0, image, false),
                              std::vector<int>(static_cast<std::size_t>(options.levels), image.size), image.size,
-                             options, progress);
+                             options, progress, &finest);
   }
   std::vector<GeometryImage> levels{image};
   for (int k = 1; k < options.levels; ++k) {
@@ -185,10 +192,11 @@ Result<std::vector<GltfLods>> build_consistent_gltf_lods(const std::vector<Geome
     GltfLodOptions o = options[m];
     o.mode = LodMode::Adaptive;
     o.levels = first.levels;
+    const TriMesh finest = geometry_image_mesh(members[m]);
     SPHEREKIT_ASSIGN_OR_RETURN(GltfLods lods,
                                build_from_meshes(adaptive_member_levels(all, m, members[m], false),
                                                  std::vector<int>(static_cast<std::size_t>(a.levels), members[m].size),
-                                                 members[m].size, o, progress));
+                                                 members[m].size, o, progress, &finest));
     out.push_back(std::move(lods));
   }
   return out;
@@ -219,7 +227,7 @@ QuantizationChoice coarse_quantization(const QuantizationChoice& shared, const G
 }
 
 Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
-                                   const GltfLodOptions& options, const ProgressFn& progress) {
+                                   const GltfLodOptions& options, const ProgressFn& progress, const TriMesh* finest) {
   const int levels = static_cast<int>(meshes.size());
   // Every level's primitive first: the shared quantization grid must hold all of them (fitted
   // levels can stray a little outside the finest level's bounding box).
@@ -242,6 +250,29 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
   encode.quantization = out.quantization.quantization;
   encode.compression_level = options.compression_level;
 
+  // Rate-distortion bits need each level's error against the original: the finest remesh's
+  // own (reference_rms_error) in squares with the level's distance to that remesh.
+  std::vector<double> level_errors;
+  double gamma = 1.0;
+  if (options.position_bits_rule == PositionBitsRule::RateDistortion) {
+    const double ref = options.reference_rms_error > 0 && std::isfinite(options.reference_rms_error)
+                           ? options.reference_rms_error
+                           : 0.0;
+    RemeshErrorOptions eo;
+    eo.samples = 20000;
+    const TriMesh top = finest ? TriMesh{} : TriMesh{meshes[0].V, meshes[0].F};
+    const TriMesh& source = finest ? *finest : top;
+    for (int k = 0; k < levels; ++k) {
+      const GltfMesh& m = meshes[static_cast<std::size_t>(k)];
+      const double d = !finest && k == 0 ? 0.0 : remesh_error(source, TriMesh{m.V, m.F}, eo).rms;
+      const double e = std::sqrt(ref * ref + (std::isfinite(d) ? d * d : 0.0));
+      level_errors.push_back(e);
+    }
+    if (levels > 1)
+      gamma = rate_exponent(static_cast<double>(meshes.front().V.rows()), level_errors.front(),
+                            static_cast<double>(meshes.back().V.rows()), level_errors.back());
+  }
+
   for (int k = 0; k < levels; ++k) {
     if (!report_progress(progress, "gltf", k, static_cast<double>(k) / levels))
       return Status(ErrorCode::Cancelled, "cancelled");
@@ -250,15 +281,29 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     level.mesh = std::move(meshes[static_cast<std::size_t>(k)]);
     if (!options.normals) level.mesh.N.resize(0, 3);
     level.quantization = out.quantization;
-    if (k > 0 && options.mode == LodMode::Adaptive && options.coarse_position_bits > 0)
-      level.quantization = coarse_quantization(out.quantization, out.levels[0].mesh, level.mesh, options);
-    DracoEncodeOptions level_encode = encode;
-    level_encode.quantization = level.quantization.quantization;
-    SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(level.mesh, level_encode));
+    const double level_error = level_errors.empty() ? 0.0 : level_errors[static_cast<std::size_t>(k)];
+    if (level_error > 0) {
+      DracoEncodeOptions level_encode = encode;
+      SPHEREKIT_ASSIGN_OR_RETURN(PositionBitsChoice c, choose_position_bits(level.mesh, level_encode, level_error, gamma,
+                                                                            std::min(options.min_position_bits_rd,
+                                                                                     encode.quantization.position_bits)));
+      level.quantization.quantization.position_bits = c.bits;
+      level.quantization.reference_rms_error = level_error;
+      level.quantization.position_max_error = level.quantization.quantization.position_step() / 2;
+      level.quantization.rate_distortion = true;
+      level.primitive = std::move(c.primitive);
+    } else {
+      if (k > 0 && options.mode == LodMode::Adaptive && options.coarse_position_bits > 0)
+        level.quantization = coarse_quantization(out.quantization, out.levels[0].mesh, level.mesh, options);
+      DracoEncodeOptions level_encode = encode;
+      level_encode.quantization = level.quantization.quantization;
+      SPHEREKIT_ASSIGN_OR_RETURN(level.primitive, encode_draco_primitive(level.mesh, level_encode));
+    }
 
     detail::GlbBuilder doc;
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, level.quantization, options.mode));
+                                     level_extras(k, level.image_size, n, level.quantization, options.mode,
+                                                  level.mesh.N.rows() > 0));
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;
@@ -282,7 +327,8 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
   for (int k = 0; k < levels; ++k) {
     const GltfLodLevel& level = out.levels[static_cast<std::size_t>(k)];
     const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, level.quantization, options.mode));
+                                     level_extras(k, level.image_size, n, level.quantization, options.mode,
+                                                  level.mesh.N.rows() > 0));
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;

@@ -158,6 +158,8 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
             lo.levels = o.lods;
             lo.budget = o.budget;
             lo.reference_rms_error = c.assets.measured ? c.assets.error.rms : 0;
+            lo.position_bits_rule = o.lod_position_bits;
+            lo.normals = o.lod_normals;  // a viewer's flat normals do not change the connectivity
             lo.name = c.name;
             lo.provenance = {c.source, info.dir};
             images.push_back(c.assets.image);

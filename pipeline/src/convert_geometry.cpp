@@ -184,6 +184,7 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
     lo.mode = o.lod_mode;
     lo.normals = o.lod_normals;
     lo.coarse_position_bits = o.lod_coarse_position_bits;
+    lo.position_bits_rule = o.lod_position_bits;
     if (adaptive) {
       SPHEREKIT_ASSIGN_OR_RETURN(out.lods, convert::build_gltf_lods(out.image, lo, progress));
     } else {

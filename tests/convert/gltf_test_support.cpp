@@ -59,6 +59,9 @@ convert::GltfLodOptions lod_test_options() {
   convert::GltfLodOptions options;
   options.levels = 3;
   options.reference_rms_error = 1e-4;
+  // The budget's bits: these tests check the budget's rule and the shared grid across levels;
+  // position_bits_test.cpp covers the rate-distortion rule.
+  options.position_bits_rule = convert::PositionBitsRule::ErrorBudget;
   options.name = "blob";
   options.provenance = {"blob.obj", "blob.sphere.obj"};
   return options;

@@ -5,6 +5,10 @@
 
   python3 tools/bench/lod_compare.py SPHEREKIT NAME MESH SPHERE MESH_AS_OBJ OUTDIR [-- CONVERT_ARGS]
 
+SPHERE = collection:DIR measures member NAME of the consistent collection DIR (its levels from
+`convert --collection`, adaptive: one connectivity for all members) against the peers run on
+MESH alone.
+
 Needs the npm tools of scripts/setup_npm_tools.sh --compare (NODE_DIR, default
 ~/.cache/spherekit/npm-tools). Peers run at every position-bit count one of our levels uses
 (their smallest size at each PSNR counts, so no level is compared against a peer at more bits
@@ -45,10 +49,16 @@ def interp(points, p):
 modes = {'adaptive': ['--lod-mode', 'adaptive'] + extra, 'uniform': ['--lod-mode', 'uniform']}
 ours, bits = {}, set()
 for mode, args in modes.items():
-    run([sk, 'convert', mesh, sphere, '-o', f'{d}/{mode}.exr', '--lods', '4', '--quiet', '--psnr-samples', '0'] + args)
+    if sphere.startswith('collection:'):
+        run([sk, 'convert', '--collection', sphere[len('collection:'):], '-o', f'{d}/{mode}_collection',
+             '--lods', '4', '--quiet'] + args)
+        level_file = lambda k: f'{d}/{mode}_collection/{name}_lod{k}.glb'
+    else:
+        run([sk, 'convert', mesh, sphere, '-o', f'{d}/{mode}.exr', '--lods', '4', '--quiet'] + args)
+        level_file = lambda k: f'{d}/{mode}_lod{k}.glb'
     ours[mode] = []
     for k in range(4):
-        f = f'{d}/{mode}_lod{k}.glb'
+        f = level_file(k)
         b = extras_bits(f)
         bits.add(b)
         ours[mode].append({'psnr': psnr(f), 'bytes': os.path.getsize(f), 'position_bits': b})
@@ -56,7 +66,7 @@ for mode, args in modes.items():
 run([B + '/gltfpack', '-i', obj, '-o', f'{d}/plain.glb', '-noq'])
 peers = {'gltfpack': [], 'gltf-transform': []}
 for pb in sorted(bits):
-    for r in ['1', '0.5', '0.25', '0.125', '0.06', '0.03', '0.015', '0.008']:
+    for r in ['1', '0.5', '0.25', '0.125', '0.06', '0.03', '0.015', '0.008', '0.004', '0.002']:
         g = f'{d}/gp{pb}_{r}.glb'
         run([B + '/gltfpack', '-i', obj, '-o', g, '-cc', '-vp', str(pb)] + ([] if r == '1' else ['-si', r]))
         peers['gltfpack'].append({'psnr': psnr(g), 'bytes': os.path.getsize(g), 'position_bits': pb, 'ratio': r})

@@ -101,10 +101,17 @@ void register_convert(CLI::App& app) {
           {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}}));
   cmd->add_flag("!--no-lod-normals", args->options.lod_normals,
                 "glTF levels without NORMAL (a viewer derives them from the triangles, as for gltfpack -cc "
-                "output); single meshes");
+                "output)");
   cmd->add_option("--lod-coarse-position-bits", args->options.lod_coarse_position_bits,
                   "adaptive glTF levels 1..: position bits from each level's own error, at least this many "
                   "(default 0: all levels use level 0's bits)");
+  cmd->add_option("--lod-position-bits", args->options.lod_position_bits,
+                  "glTF levels: position bits per level by rate and distortion (default: the smallest file at "
+                  "the level's own error, README) or from the error budget (level 0's bits, at least "
+                  "--min-position-bits, for every level)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, convert::PositionBitsRule>{
+          {"rate-distortion", convert::PositionBitsRule::RateDistortion},
+          {"budget", convert::PositionBitsRule::ErrorBudget}}));
   cmd->add_option("--min-position-bits", args->options.budget.min_position_bits,
                   "glTF: fewest Draco position bits (default 14; more if the error budget needs them)");
   cmd->add_option("--normal-bits", args->options.budget.normal_bits, "glTF: Draco normal bits (default 10)");

@@ -77,6 +77,9 @@ struct QuantizationChoice {
   double position_error_fraction = 0;  ///< the fraction used
   /// Largest per-coordinate position error step/2 and the RMS 3D displacement (also step/2).
   double position_max_error = 0;
+  /// The bits were chosen by rate and distortion (position_bits.h), not by the budget; then
+  /// reference_rms_error is the level's own error the choice was made against.
+  bool rate_distortion = false;
 };
 
 /// Chooses the grids for a primitive (or for several levels of detail of one model: pass the

@@ -60,6 +60,17 @@ enum class LodMode {
   Adaptive,
 };
 
+/// How each level's position bits are chosen.
+enum class PositionBitsRule {
+  /// QuantizationBudget: level 0's bits for every level (coarse_position_bits aside).
+  ErrorBudget,
+  /// position_bits.h: per level, the bits that give the smallest file at the level's error
+  /// (its own error: reference_rms_error in squares with its RMS distance to the finest
+  /// remesh). A level whose error is unknown (level 0 of uniform levels with no
+  /// reference_rms_error) keeps the budget's bits.
+  RateDistortion,
+};
+
 struct GltfLodOptions {
   // Shape-defining
   LodMode mode = LodMode::Uniform;
@@ -85,6 +96,8 @@ struct GltfLodOptions {
   /// level has the shared bits). A coarse level's error is many times level 0's, so the bits
   /// level 0 needs are far below its error and only cost bytes.
   int coarse_position_bits = 0;
+  PositionBitsRule position_bits_rule = PositionBitsRule::RateDistortion;
+  int min_position_bits_rd = 6;  ///< RateDistortion: never fewer bits than this
   std::string name = "mesh";    ///< node and mesh names: NAME_LOD0, NAME_LOD1, ...
   GltfProvenance provenance;
   // Effort

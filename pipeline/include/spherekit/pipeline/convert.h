@@ -39,8 +39,11 @@ struct ConvertOptions {
   /// How the levels are made (gltf_lods.h). Uniform by default: measured against gltfpack and
   /// gltf-transform at equal PSNR (issue 22), the adaptive levels do not win yet.
   convert::LodMode lod_mode = convert::LodMode::Uniform;
-  bool lod_normals = true;
-  int lod_coarse_position_bits = 0;  ///< GltfLodOptions::coarse_position_bits (adaptive single meshes)  ///< glTF levels carry NORMAL (GltfLodOptions::normals; single meshes)
+  bool lod_normals = true;  ///< glTF levels carry NORMAL (GltfLodOptions::normals; single meshes)
+  int lod_coarse_position_bits = 0;  ///< GltfLodOptions::coarse_position_bits (adaptive single meshes)
+  /// GltfLodOptions::position_bits_rule: each level's bits by rate and distortion (default) or
+  /// level 0's bits from the error budget for all.
+  convert::PositionBitsRule lod_position_bits = convert::PositionBitsRule::RateDistortion;
   convert::QuantizationBudget budget;               ///< their Draco quantization
   int cage = 0;                                     ///< cage quads per cube-face edge (0: no cage)
   int cage_tile = 17;                               ///< displacement samples per quad edge

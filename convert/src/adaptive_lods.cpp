@@ -95,6 +95,8 @@ Status check_members(const std::vector<GeometryImage>& members, const AdaptiveLo
   }
   if (options.levels < 1 || options.levels > 16)
     return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: levels must be in 1..16");
+  if (options.lod0_max_vertices < 0)
+    return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: lod0 vertex cap must be >= 0");
   if (!(options.lod0_vertex_fraction > 0 && options.lod0_vertex_fraction <= 1))
     return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: lod0 vertex fraction must be in (0, 1]");
   return Status();
@@ -148,9 +150,10 @@ Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector
     pm_options.keep_vertices[static_cast<std::size_t>(v)] =
         on_seam[static_cast<std::size_t>(v)] == 1 || on_seam[static_cast<std::size_t>(v)] > 2;
   std::vector<int> targets;
+  double lod0 = nv * options.lod0_vertex_fraction;
+  if (options.lod0_max_vertices > 0) lod0 = std::min(lod0, static_cast<double>(options.lod0_max_vertices));
   for (int k = 0; k < options.levels; ++k)
-    targets.push_back(std::max(
-        6, static_cast<int>(std::lround(nv * options.lod0_vertex_fraction / std::pow(4.0, static_cast<double>(k))))));
+    targets.push_back(std::max(6, static_cast<int>(std::lround(lod0 / std::pow(4.0, static_cast<double>(k))))));
   pm_options.target_vertices = std::min(nv, targets.back());
   SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, F, pm_options, progress));
 

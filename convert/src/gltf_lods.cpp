@@ -119,6 +119,7 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
     AdaptiveLodOptions a;
     a.levels = options.levels;
     a.lod0_vertex_fraction = options.lod0_vertex_fraction;
+    a.lod0_max_vertices = options.lod0_max_vertices;
     a.drop_hole_faces = options.drop_hole_faces;  // exactly, by the simplifier's rim constraint
     SPHEREKIT_ASSIGN_OR_RETURN(auto all, adaptive_lod_meshes({image}, a, progress));
     // The surface the levels approximate: with the holes open when the levels leave them out
@@ -187,6 +188,7 @@ Result<std::vector<GltfLods>> build_consistent_gltf_lods(const std::vector<Geome
   AdaptiveLodOptions a;
   a.levels = first.levels;
   a.lod0_vertex_fraction = first.lod0_vertex_fraction;
+  for (const GltfLodOptions& o : options) a.lod0_max_vertices = std::max(a.lod0_max_vertices, o.lod0_max_vertices);
   SPHEREKIT_ASSIGN_OR_RETURN(auto all, adaptive_lod_meshes(members, a, progress));
   for (std::size_t m = 0; m < members.size(); ++m) {
     GltfLodOptions o = options[m];

@@ -185,6 +185,7 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
     lo.normals = o.lod_normals;
     lo.coarse_position_bits = o.lod_coarse_position_bits;
     lo.position_bits_rule = o.lod_position_bits;
+    lo.lod0_max_vertices = static_cast<int>(mesh.V.rows());
     if (adaptive) {
       SPHEREKIT_ASSIGN_OR_RETURN(out.lods, convert::build_gltf_lods(out.image, lo, progress));
     } else {

@@ -3,6 +3,7 @@
 // growing with the level, no face across the octahedral fold, determinism.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -161,4 +162,28 @@ TEST_CASE("Adaptive LODs: coarse levels' position bits from their own error; no 
   CHECK(built->levels.back().quantization.quantization.position_bits < shared);
   const std::string json = built->levels.back().glb.substr(20, 4000);
   CHECK(json.find("\"NORMAL\"") == std::string::npos);
+}
+
+TEST_CASE("Adaptive LODs: level 0 has no more vertices than the cap (the original mesh's count)", "[convert]") {
+  const GeometryImage gi = test::blob_geometry_image(65, 3, 7);
+  AdaptiveLodOptions a;
+  a.levels = 3;
+  auto free_levels = adaptive_lod_meshes({gi}, a);
+  a.lod0_max_vertices = 300;
+  auto capped = adaptive_lod_meshes({gi}, a);
+  REQUIRE(free_levels.ok());
+  REQUIRE(capped.ok());
+  auto vertices = [](const GltfMesh& m) {
+    return 1 + *std::max_element(m.position_index.begin(), m.position_index.end());
+  };
+  const int free0 = vertices((*free_levels)[0][0]);
+  CHECK(free0 > 300);  // the cap binds
+  for (std::size_t k = 0; k < 3; ++k) {
+    INFO("level " << k);
+    const int v = vertices((*capped)[k][0]);
+    CHECK(v <= static_cast<int>(std::lround(300 / std::pow(4.0, static_cast<double>(k)))) + 8);  // + fold/corner keeps
+    CHECK(v >= 6);
+  }
+  a.lod0_max_vertices = -1;
+  CHECK(adaptive_lod_meshes({gi}, a).status().code() == ErrorCode::InvalidArgument);
 }

@@ -23,8 +23,11 @@
 // faces and points at every level; the n-D quadric measures the error of all members at once.
 // Each level's members therefore still make a morph-target glTF (gltf_morph.h).
 //
-// Level k has max(4, round(V * lod0_vertex_fraction / 4^k)) vertices, V the remesh's: the
-// uniform images' factor 4 per level.
+// Level k has max(6, round(L / 4^k)) vertices, L = V * lod0_vertex_fraction (V the remesh's)
+// or lod0_max_vertices if fewer: the uniform images' factor 4 per level. The cap is the
+// original mesh's vertex count: a remesh with more vertices than the mesh it stands for
+// cannot be as good as that mesh (its vertices are exact samples, the remesh's are not), and
+// would only cost bytes (TOSCA cat0, 5000 vertices: level 0 had 16.5k).
 #pragma once
 
 #include <vector>
@@ -41,6 +44,9 @@ struct AdaptiveLodOptions {
   /// Vertices of level 0 as a fraction of the finest remesh's (0, 1]; each further level has a
   /// quarter of the previous one's.
   double lod0_vertex_fraction = 0.25;
+  /// At most this many vertices in level 0 (0: no cap); the original mesh's vertex count (the
+  /// largest member's for a collection).
+  int lod0_max_vertices = 0;
   /// Leave out the faces spanning holes of member 0 (geometry_image_hole_faces). The rim
   /// between them and the surface is a simplifier constraint (like the octahedral fold), so
   /// every face keeps its side at every level and the holes stay the size they are in the

@@ -76,6 +76,7 @@ struct GltfLodOptions {
   LodMode mode = LodMode::Uniform;
   /// Adaptive: vertices of level 0 as a fraction of the finest remesh's (adaptive_lods.h).
   double lod0_vertex_fraction = 0.25;
+  int lod0_max_vertices = 0;  ///< Adaptive: cap on level 0's vertices (adaptive_lods.h; 0: none)
   int levels = 4;  ///< number of levels (>= 1); (N-1)/2^(levels-1) must be >= 2
   QuantizationBudget budget;  ///< how the quantization is chosen (gltf_draco.h)
   /// RMS surface error of level 0 against the original mesh (absolute units; remesh_error().rms

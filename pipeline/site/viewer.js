@@ -31,7 +31,8 @@
   // may not fetch). The script hands its base64 text to spherekitGlb.
   var waiting = {};   // path -> {resolve, reject}
   var loaded = {};    // path -> Promise<ArrayBuffer>
-  window.spherekitGlb = function (path, base64) {
+  // site/glb/*.js call spherekitGlb, the landmark editor's site/mesh/*.js spherekitMesh.
+  window.spherekitGlb = window.spherekitMesh = function (path, base64) {
     var w = waiting[path];
     if (!w) return;
     delete waiting[path];
@@ -530,6 +531,12 @@
     }).catch(function (e) { fail(status, entry.label || entry.glb.path, e); })
       .then(function () { state.pending--; });
   }
+
+  // What site/landmarks.js (the landmark editor, loaded after this script) builds on.
+  window.spherekitViewerParts = {
+    state: state, byId: byId, setText: setText, fail: fail, button: button, View: View, loadScript: loadGlb,
+    surfaceMaterial: surfaceMaterial
+  };
 
   try {
     modelViewer(site.models || []);

@@ -379,6 +379,27 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
                            {"cpu_seconds", cpu_seconds()},
                            {"peak_rss_mb", peak_rss_mb()}};
 
+  // The page's landmark editor (issue 25): every mapped mesh with the landmarks this job used
+  // (proposed into OUT/landmarks/, or the NAME.lm.txt beside it, or none yet), to check and fix.
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const Json& mesh = report["meshes"][i];
+    if (mesh.value("status", "") != "ok") continue;
+    std::string features = feature_files.empty() ? std::string() : feature_files[i];
+    std::string source;
+    if (!features.empty()) {
+      source = "proposed by spherekit (as 'spherekit landmarks'): " + features +
+               "; how sure each match is: landmarks_report.json";
+    } else if (const fs::path beside = fs::path(inputs[i]).parent_path() / (stem_of(inputs[i]) + ".lm.txt");
+               fs::is_regular_file(beside, ec)) {
+      features = beside.string();
+      source = "given: " + features;
+    } else {
+      source = "no landmark file yet (" + beside.string() + " does not exist)";
+    }
+    site["landmarks"]["members"].push_back(
+        {{"name", mesh["name"]}, {"mesh", inputs[i]}, {"features", features}, {"source", source}});
+  }
+
   SPHEREKIT_RETURN_IF_ERROR(write_site_page(out_dir.string(), site, &out.warnings));
   report["page"] = (out_dir / "index.html").string();
   SPHEREKIT_RETURN_IF_ERROR(formats::write_file_atomic((out_dir / "report.json").string(), report.dump(2) + "\n"));

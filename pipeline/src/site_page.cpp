@@ -10,7 +10,8 @@
 #include <set>
 #include <system_error>
 
-#include "site_assets.h"  // generated from site/viewer.js and site/style.css (CMakeLists.txt)
+#include "site_assets.h"
+#include "site_landmarks.h"  // generated from site/viewer.js and site/style.css (CMakeLists.txt)
 #include "spherekit/formats/atomic_file.h"
 #include "spherekit/version.h"
 
@@ -123,7 +124,7 @@ const Json& array(const Json& j, const char* key) {
 struct PageWriter {
   std::string out;                 // out_dir
   std::vector<std::string>* warnings;
-  std::set<std::string> glb_scripts;  // site/glb/*.js written this time
+  std::set<std::string> scripts;  // site/glb/*.js and site/mesh/*.js written this time
 
   void warn(const std::string& w) {
     if (warnings) warnings->push_back(w);
@@ -156,29 +157,37 @@ struct PageWriter {
     return formats::write_file_atomic(full.string(), bytes);
   }
 
+  // Writes site/FOLDER/NNN_stem.js, a script calling `function`(key, "base64 of bytes"), and
+  // returns its entry for data.js. The page loads it when it needs the bytes (file:// pages
+  // may not fetch).
+  Result<Json> script_entry(const std::string& key, const std::string& stem_of, const std::string& bytes,
+                            const std::string& folder, const std::string& function) {
+    std::string stem = fs::path(stem_of).stem().string();
+    for (char& c : stem)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+    char prefix[16];
+    std::snprintf(prefix, sizeof prefix, "%03zu_", scripts.size());
+    const std::string script = "site/" + folder + "/" + std::string(prefix) + stem + ".js";
+    scripts.insert(script);
+    SPHEREKIT_RETURN_IF_ERROR(write(script, function + "(" + json_text(key) + ",\"" + base64(bytes) + "\");\n"));
+    return Json{{"path", key}, {"script", script}, {"bytes", bytes.size()}};
+  }
+
   // Writes site/glb/NNN_name.js holding the .glb at `path` and returns its entry for data.js.
   Result<Json> glb_entry(const std::string& path) {
     auto bytes = formats::read_file((fs::path(out) / path).string());
     if (!bytes.ok()) return bytes.status();
-    std::string stem = fs::path(path).stem().string();
-    for (char& c : stem)
-      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
-    char prefix[16];
-    std::snprintf(prefix, sizeof prefix, "%03zu_", glb_scripts.size());
-    const std::string script = "site/glb/" + std::string(prefix) + stem + ".js";
-    glb_scripts.insert(script);
-    SPHEREKIT_RETURN_IF_ERROR(
-        write(script, "spherekitGlb(" + json_text(path) + ",\"" + base64(bytes.value()) + "\");\n"));
-    return Json{{"path", path}, {"script", script}, {"bytes", bytes->size()}};
+    return script_entry(path, path, bytes.value(), "glb", "spherekitGlb");
   }
 
   // Scripts of earlier pages that this one no longer lists.
-  void remove_stale_glb_scripts() {
+  void remove_stale_scripts() {
     std::error_code ec;
-    for (const auto& e : fs::directory_iterator(fs::path(out) / "site/glb", ec)) {
-      const std::string rel = "site/glb/" + e.path().filename().string();
-      if (e.path().extension() == ".js" && !glb_scripts.count(rel)) fs::remove(e.path(), ec);
-    }
+    for (const char* folder : {"site/glb", "site/mesh"})
+      for (const auto& e : fs::directory_iterator(fs::path(out) / folder, ec)) {
+        const std::string rel = std::string(folder) + "/" + e.path().filename().string();
+        if (e.path().extension() == ".js" && !scripts.count(rel)) fs::remove(e.path(), ec);
+      }
   }
 };
 
@@ -316,6 +325,25 @@ Status write_site_page(const std::string& out_dir, const Json& site, std::vector
                              {"glb", std::move(entry)}});
     }
 
+    // The landmark editor (issue 25): each member's mesh as read, with its feature file.
+    Json data_landmarks = Json::array();
+    static const Json no_landmarks;
+    const auto landmarks_it = site.find("landmarks");
+    const Json& landmark_members = array(landmarks_it != site.end() ? *landmarks_it : no_landmarks, "members");
+    for (const Json& m : landmark_members) {
+      if (!viewer) break;
+      auto member = detail::landmark_member_data(m);
+      if (!member.ok()) {
+        w.warn("landmarks: " + member.status().message() + ", not shown");
+        continue;
+      }
+      SPHEREKIT_ASSIGN_OR_RETURN(Json script, w.script_entry("mesh:" + member->entry["name"].get<std::string>(),
+                                                             member->entry["name"].get<std::string>() + ".mesh",
+                                                             member->payload, "mesh", "spherekitMesh"));
+      member->entry["mesh"] = std::move(script);
+      data_landmarks.push_back(std::move(member->entry));
+    }
+
     // ---- index.html
     std::string body;
     const bool models_3d = viewer && !data_models.empty();
@@ -325,7 +353,7 @@ Status write_site_page(const std::string& out_dir, const Json& site, std::vector
       nav += "<a href=\"#" + id + "\">" + html(text) + "</a>";
     };
 
-    const bool any_3d_listed = !array(site, "models").empty() || !morph_items.empty();
+    const bool any_3d_listed = !array(site, "models").empty() || !morph_items.empty() || !landmark_members.empty();
     if (!viewer && any_3d_listed) {
       add_nav("models", "3-D models");
       body += "<section id=\"models\"><h2>3-D models</h2>\n<p class=\"note\" id=\"no-viewer\">No 3-D view: " +
@@ -352,6 +380,29 @@ Status write_site_page(const std::string& out_dir, const Json& site, std::vector
               "\"auto\" picks coarser levels as the model gets smaller on screen. \"shared texture\" paints one grid "
               "through the common domain: in a consistent collection each cell lands on the same part of every "
               "model (compare them with \"all, side by side\").</p></div></section>\n";
+    }
+    if (viewer && !data_landmarks.empty()) {
+      add_nav("landmarks", "landmarks");
+      body += "<section id=\"landmarks\"><h2>Landmarks</h2>\n<div class=\"viewer\" id=\"landmark-viewer\">\n"
+              "<div class=\"toolbar\"><label>member <select id=\"landmark-member\">";
+      for (std::size_t i = 0; i < data_landmarks.size(); ++i)
+        body += "<option value=\"" + std::to_string(i) + "\">" + html(data_landmarks[i]["name"].get<std::string>()) +
+                "</option>";
+      body += "</select></label>"
+              "<button type=\"button\" id=\"landmark-download\">download .lm.txt</button>"
+              "<button type=\"button\" id=\"landmark-download-all\">download all</button>"
+              "<label><input type=\"checkbox\" id=\"landmark-labels\" checked> labels</label>"
+              "<label><input type=\"checkbox\" id=\"landmark-wireframe\"> edges</label></div>\n"
+              "<div class=\"canvas-box\" id=\"landmark-canvas\"></div>\n"
+              "<p class=\"status\" id=\"landmark-status\">loading the landmarks...</p>\n"
+              "<p class=\"status\" id=\"landmark-source\"></p>\n"
+              "<ol class=\"landmark-list\" id=\"landmark-list\"></ol>\n"
+              "<p class=\"status\">Each member is shown as its own input mesh (not a remesh), so the vertex numbers "
+              "are the ones its <code>.lm.txt</code> file uses. Click the surface to place a landmark at the nearest "
+              "vertex; click a landmark's \"move\" and then the surface to move it; edit a name to rename it. "
+              "The consistent collection needs the same names on every member. \"download\" saves the member's "
+              "<code>NAME.lm.txt</code> (lines <code>name vertex_index</code>); put it beside the mesh and rerun, or "
+              "check it with <code>spherekit check MESH --landmarks NAME.lm.txt</code>.</p></div></section>\n";
     }
     if (morphs_3d) {
       add_nav("morphs", "morphs");
@@ -400,18 +451,21 @@ Status write_site_page(const std::string& out_dir, const Json& site, std::vector
       page += " 3-D view: " + html(viewer_versions.empty() ? "three.js" : viewer_versions) +
               " and Google's Draco decoder (<a href=\"site/lib/NOTICE.txt\">notices</a>).";
     page += "</footer>\n";
-    if (models_3d || morphs_3d) {
+    if (models_3d || morphs_3d || (viewer && !data_landmarks.empty())) {
       SPHEREKIT_RETURN_IF_ERROR(w.write("site/data.js", "window.SPHEREKIT_SITE = " +
                                                             json_text(Json{{"title", title},
                                                                            {"models", data_models},
-                                                                           {"morphs", data_morphs}}) +
+                                                                           {"morphs", data_morphs},
+                                                                           {"landmarks", data_landmarks}}) +
                                                             ";\n"));
       SPHEREKIT_RETURN_IF_ERROR(w.write("site/viewer.js", kSiteViewerJs));
+      SPHEREKIT_RETURN_IF_ERROR(w.write("site/landmarks.js", kSiteLandmarksJs));
       page += "<script src=\"site/lib/three-viewer.js\"></script>\n<script src=\"site/lib/draco_decoder.js\"></script>\n"
-              "<script src=\"site/data.js\"></script>\n<script src=\"site/viewer.js\"></script>\n";
+              "<script src=\"site/data.js\"></script>\n<script src=\"site/viewer.js\"></script>\n"
+              "<script src=\"site/landmarks.js\"></script>\n";
     }
     page += "</body></html>\n";
-    w.remove_stale_glb_scripts();
+    w.remove_stale_scripts();
     // Last, so that the page never lists a file that is not written yet.
     return w.write("index.html", page);
   } catch (const std::exception& e) {

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -214,4 +215,92 @@ TEST_CASE("results page: a description that is not an object is an invalid argum
   CHECK_FALSE(fs::exists(out + "/index.html"));
   REQUIRE(pipeline::write_site_page(out, Json::object({{"viewer_dir", out + "/none"}, {"models", "not a list"}})).ok());
   CHECK(contains(test::slurp(out + "/index.html"), "<h1>SphereKit results</h1>"));
+}
+
+TEST_CASE("results page: the landmark editor's meshes as scripts in the input's vertex numbering, its landmarks, "
+          "unreadable files", "[pipeline]") {
+  const std::string out = test::temp_dir("site_page_landmarks"), viewer = test::temp_dir("site_page_landmarks_lib");
+  const std::string in = test::temp_dir("site_page_landmarks_in");
+  put(viewer + "/dist/three-viewer.js", "var THREE = {};\n");
+  put(viewer + "/dist/draco_decoder.js", "function DracoDecoderModule() {}\n");
+  // A tetrahedron far from the origin (the page gets positions minus the box centre), with
+  // its faces in an order the file gives and no reader should change.
+  put(in + "/tet.obj", "v 1000 0 0\nv 1001 0 0\nv 1000 1 0\nv 1000 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  put(in + "/tet.lm.txt", "# two\ntip 3\nbase 0\n");
+  put(in + "/bad.lm.txt", "tip 7\n");
+  put(out + "/site/mesh/777_old.js", "stale");
+  const Json site = {{"viewer_dir", viewer},
+                     {"landmarks",
+                      {{"members",
+                        {{{"name", "tet"}, {"mesh", in + "/tet.obj"}, {"features", in + "/tet.lm.txt"}, {"source", "given"}},
+                         {{"name", "none yet"}, {"mesh", in + "/tet.obj"}},
+                         {{"name", "bad file"}, {"mesh", in + "/tet.obj"}, {"features", in + "/bad.lm.txt"}},
+                         {{"name", "gone"}, {"mesh", in + "/gone.obj"}}}}}}};
+  std::vector<std::string> warnings;
+  REQUIRE(pipeline::write_site_page(out, site, &warnings).ok());
+  REQUIRE(warnings.size() == 1);  // the mesh that cannot be read
+  CHECK(contains(warnings[0], in + "/gone.obj"));
+  CHECK_FALSE(fs::exists(out + "/site/mesh/777_old.js"));
+  CHECK(test::slurp(out + "/site/landmarks.js") == test::slurp(SPHEREKIT_SOURCE_DIR "/pipeline/site/landmarks.js"));
+
+  const std::string data_js = test::slurp(out + "/site/data.js");
+  const std::string prefix = "window.SPHEREKIT_SITE = ";
+  REQUIRE(data_js.rfind(prefix, 0) == 0);
+  const auto data = nlohmann::json::parse(data_js.substr(prefix.size(), data_js.rfind(';') - prefix.size()));
+  const auto& members = data.at("landmarks");
+  REQUIRE(members.size() == 3);
+  CHECK(members[0]["name"] == "tet");
+  CHECK(members[0]["file"] == "tet.lm.txt");
+  CHECK(members[0]["source"] == "given");
+  CHECK(members[0]["vertices"] == 4);
+  CHECK(members[0]["triangles"] == 4);
+  CHECK(members[0]["landmarks"] == nlohmann::json::parse(R"([{"name":"tip","vertex":3},{"name":"base","vertex":0}])"));
+  CHECK_FALSE(members[0].contains("error"));
+  CHECK(members[1]["landmarks"].empty());
+  CHECK_FALSE(members[1].contains("error"));
+  CHECK(members[2]["landmarks"].empty());
+  CHECK(contains(members[2].at("error").get<std::string>(), in + "/bad.lm.txt"));
+
+  // The script's bytes: #V, #F, positions minus the offset (float32), the faces as in the file.
+  const auto& script_entry = members[0].at("mesh");
+  const std::string script = test::slurp(out + "/" + script_entry.at("script").get<std::string>());
+  const std::string call = "spherekitMesh(\"" + script_entry.at("path").get<std::string>() + "\",\"";
+  REQUIRE(script.rfind(call, 0) == 0);
+  const std::string bytes = base64_decode(script.substr(call.size(), script.rfind('"') - call.size()));
+  REQUIRE(bytes.size() == 8 + 12 * 4 + 12 * 4);
+  auto u32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = v << 8 | static_cast<unsigned char>(bytes[at + k]);
+    return v;
+  };
+  auto f32 = [&](std::size_t at) {
+    const std::uint32_t v = u32(at);
+    float f;
+    std::memcpy(&f, &v, sizeof f);
+    return static_cast<double>(f);
+  };
+  CHECK(u32(0) == 4);
+  CHECK(u32(4) == 4);
+  const double file_v[4][3] = {{1000, 0, 0}, {1001, 0, 0}, {1000, 1, 0}, {1000, 0, 1}};
+  const auto& offset = members[0].at("offset");
+  CHECK(offset[0].get<double>() == 1000.5);
+  for (int v = 0; v < 4; ++v)
+    for (int c = 0; c < 3; ++c) CHECK(f32(8 + 12 * v + 4 * c) + offset[c].get<double>() == file_v[v][c]);
+  const std::uint32_t file_f[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  for (int f = 0; f < 4; ++f)
+    for (int c = 0; c < 3; ++c) CHECK(u32(8 + 48 + 12 * f + 4 * c) == file_f[f][c]);
+
+  const std::string page = test::slurp(out + "/index.html");
+  CHECK(contains(page, "<option value=\"1\">none yet</option>"));
+  CHECK(contains(page, "<script src=\"site/landmarks.js\"></script>"));
+  CHECK(page.find("site/viewer.js") < page.find("site/landmarks.js"));
+
+  // Without the viewer: no editor, and the note says why there is no 3-D view.
+  const std::string bare = test::temp_dir("site_page_landmarks_bare");
+  Json no_viewer = site;
+  no_viewer["viewer_dir"] = bare + "/none";
+  REQUIRE(pipeline::write_site_page(bare, no_viewer).ok());
+  CHECK(contains(test::slurp(bare + "/index.html"), "id=\"no-viewer\""));
+  CHECK_FALSE(contains(test::slurp(bare + "/index.html"), "landmark-canvas"));
+  CHECK_FALSE(fs::exists(bare + "/site/mesh"));
 }

@@ -8,6 +8,8 @@
 // OUT/site/data.js, and the Draco primitives are decoded on the page's thread by Google's
 // JavaScript Draco decoder instead of three.js's DRACOLoader (which fetches its decoder and
 // runs it in a worker). Images, plots and tables are plain HTML, visible without JavaScript.
+// The landmark editor's meshes are scripts too (OUT/site/mesh/*.js), and its downloads are
+// made in the page (Blob URLs), so they also work from disk.
 //
 // three.js and the decoder come from npm (scripts/setup_viewer.sh builds them into
 // ~/.cache/spherekit/viewer/dist); they are copied into OUT/site/lib. When they are not
@@ -39,6 +41,8 @@ using Json = nlohmann::ordered_json;
 ///       "morph": {"glb": "apps/morph.glb", "label": "a to b", "mode": "sequence"},
 ///       "plots": [{"label": "PCA error", "png": "apps/pca_error.png"}],
 ///       "tables": [{"label": "maps", "columns": ["mesh", "efficiency"], "rows": [["a", 0.71]]}],
+///       "landmarks": {"members": [{"name": "a", "mesh": "/in/a.obj", "features": "/in/a.lm.txt",
+///                                  "source": "given: /in/a.lm.txt"}]},
 ///       "viewer_dir": "/abs/folder"     // where scripts/setup_viewer.sh installed the viewer
 ///     }
 ///
@@ -46,6 +50,13 @@ using Json = nlohmann::ordered_json;
 ///   successive frames, one slider runs through them) or "weights" (independent targets such
 ///   as principal components: one slider per target, weight -3..3).
 /// - Table cells are strings, numbers (6 significant digits), booleans or null (empty).
+/// - "landmarks" (issue 25): the landmark editor. Its "mesh" and "features" are input files
+///   (any path, not only inside `out_dir`): each mesh is read as formats::read_mesh reads it
+///   and written for the page into `out_dir`/site/mesh/*.js (positions as float32, the
+///   original vertex numbering), so that a vertex picked on the page is the index every
+///   `.lm.txt` reader expects. "features" empty or absent: no landmarks yet. A mesh that
+///   cannot be read is skipped with a warning; a feature file that does not read against its
+///   mesh shows the member without landmarks and says why.
 /// - "viewer_dir" is normally absent: then $SPHEREKIT_VIEWER_DIR, else
 ///   $HOME/.cache/spherekit/viewer; the viewer files are its dist/ folder.
 ///

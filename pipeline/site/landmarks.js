@@ -16,9 +16,13 @@
     member: -1, selected: -1, moving: -1, picks: 0, downloads: 0, message: '', lastPick: null, mesh: null, view: null,
     members: members.map(function (m) {
       return {
-        name: m.name, file: m.file, source: m.source || '', error: m.error || '', vertices: m.vertices,
-        offset: m.offset || [0, 0, 0], revision: 0, saved: 0,
-        landmarks: (m.landmarks || []).map(function (l) { return { name: l.name, vertex: l.vertex }; })
+        name: m.name, file: m.file, source: m.source || '', error: m.error || '', note: m.note || '',
+        vertices: m.vertices, offset: m.offset || [0, 0, 0], revision: 0, saved: 0,
+        // A proposal's confidence belongs to its point: kept on rename, dropped on a move.
+        landmarks: (m.landmarks || []).map(function (l) {
+          var c = m.confidence && typeof m.confidence[l.name] === 'number' ? m.confidence[l.name] : null;
+          return { name: l.name, vertex: l.vertex, confidence: c };
+        })
       };
     })
   };
@@ -130,11 +134,12 @@
     var m = current(), lacking = allNames().filter(function (name) { return !has(m, name); });
     var text = m.source ? 'landmarks: ' + m.source : '';
     if (m.error) text += (text ? '. ' : '') + 'The landmark file could not be read: ' + m.error;
+    if (m.note) text += (text ? '. ' : '') + m.note;
     text += (text ? '. ' : '') + m.name + ': ' + m.landmarks.length + ' landmarks on ' + m.vertices + ' vertices' +
       (m.revision !== m.saved ? ', edited since the last download' : '') +
       (lacking.length ? '; missing here, on other members: ' + lacking.join(', ') : '');
     sourceEl.textContent = text;
-    sourceEl.className = m.error ? 'status error' : 'status';
+    sourceEl.className = m.error ? 'status error' : m.note ? 'status warn' : 'status';
     if (downloadButton) downloadButton.textContent = 'download ' + m.file;
   }
   function buildList() {
@@ -154,6 +159,14 @@
       if (missing.length) where.textContent += ' (not on ' + missing.join(', ') + ')';
       li.appendChild(input);
       li.appendChild(where);
+      if (l.confidence !== null && l.confidence !== undefined) {
+        // Below one half the proposal was unsure of this match: the first ones to check.
+        var sure = document.createElement('span');
+        sure.className = 'landmark-confidence' + (l.confidence < 0.5 ? ' low' : '');
+        sure.textContent = ' confidence ' + l.confidence.toFixed(2);
+        sure.title = 'how sure the proposal is of this match (landmarks_report.json)';
+        li.appendChild(sure);
+      }
       var move = parts.button('move', function () {
         ed.moving = ed.moving === i ? -1 : i;
         ed.selected = i;
@@ -242,6 +255,7 @@
       }
       var from = l.vertex;
       l.vertex = at.vertex;
+      l.confidence = null;
       ed.selected = ed.moving;
       ed.moving = -1;
       m.revision++;
@@ -251,7 +265,7 @@
       say('selected ' + m.landmarks[held].name + ' (vertex ' + at.vertex + '): "move" moves it');
     } else {
       var name = freeName(m);
-      m.landmarks.push({ name: name, vertex: at.vertex });
+      m.landmarks.push({ name: name, vertex: at.vertex, confidence: null });
       ed.selected = m.landmarks.length - 1;
       m.revision++;
       say('placed ' + name + ' at vertex ' + at.vertex + ' (edit its name below to rename it)');

@@ -278,6 +278,7 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
   // beside the user's meshes), and the collection is made with those.
   bool collection = use_samples;
   std::vector<std::string> feature_files;
+  Json proposal_notes = Json::array();  // per member, for the page: confidence per name, mirror flag
   if (!use_samples && inputs.size() >= 2 && out.failed == 0) {
     collection = true;
     bool all = true;
@@ -299,6 +300,17 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
                       "): each mesh is mapped alone; give NAME.lm.txt files for a consistent collection");
       } else {
         feature_files = lr->files;
+        for (std::size_t i = 0; i < lr->proposal.members.size(); ++i) {
+          const LandmarkMemberMatch& mm = lr->proposal.members[i];
+          Json confidence = Json::object();
+          for (std::size_t k = 0; k < lr->proposal.landmarks[i].size(); ++k)
+            confidence[lr->proposal.landmarks[i][k].name] = lr->proposal.confidence[i][k];
+          proposal_notes.push_back(
+              {{"confidence", confidence},
+               {"note", mm.mirror_ambiguous ? "left/right undecided: check the left and right landmarks"
+                        : mm.mirrored   ? "this member looks like a mirror image of the reference: check left and right"
+                                        : ""}});
+        }
         int flagged = 0;
         for (const auto& m : lr->proposal.members) flagged += m.mirror_ambiguous || m.mirrored;
         observer.note("the meshes came without feature files (NAME.lm.txt): proposed " +
@@ -396,8 +408,12 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
     } else {
       source = "no landmark file yet (" + beside.string() + " does not exist)";
     }
-    site["landmarks"]["members"].push_back(
-        {{"name", mesh["name"]}, {"mesh", inputs[i]}, {"features", features}, {"source", source}});
+    Json member = {{"name", mesh["name"]}, {"mesh", inputs[i]}, {"features", features}, {"source", source}};
+    if (i < proposal_notes.size()) {
+      member["confidence"] = proposal_notes[i]["confidence"];
+      member["note"] = proposal_notes[i]["note"];
+    }
+    site["landmarks"]["members"].push_back(std::move(member));
   }
 
   SPHEREKIT_RETURN_IF_ERROR(write_site_page(out_dir.string(), site, &out.warnings));

@@ -63,6 +63,14 @@ Result<LandmarkMemberData> landmark_member_data(const Json& member) {
   e["vertices"] = nv;
   e["triangles"] = nf;
   e["landmarks"] = Json::array();
+  if (const std::string note = text(member, "note"); !note.empty()) e["note"] = note;
+  // How sure a proposal is of each name (0..1), shown beside it: what to check first.
+  if (auto c = member.find("confidence"); c != member.end() && c->is_object()) {
+    Json confidence = Json::object();
+    for (const auto& [name, value] : c->items())
+      if (value.is_number()) confidence[name] = value;
+    e["confidence"] = std::move(confidence);
+  }
   if (const std::string features = text(member, "features"); !features.empty()) {
     auto lms = formats::read_landmarks(features, static_cast<int>(nv));
     if (!lms.ok()) {

@@ -12,7 +12,8 @@ namespace spherekit::pipeline::detail {
 
 struct LandmarkMemberData {
   /// For data.js: name, file (the download's name), source, offset, vertices, triangles,
-  /// landmarks [{name, vertex}], and "error" when the feature file could not be read.
+  /// landmarks [{name, vertex}], "confidence" and "note" when given, and "error" when the
+  /// feature file could not be read.
   Json entry;
   /// The mesh for the page: little-endian u32 #V, u32 #F, then #V x 3 float32 positions
   /// minus `offset` (float32 keeps its precision near the origin, whatever the mesh's
@@ -22,7 +23,8 @@ struct LandmarkMemberData {
 
 /// One entry of the description's "landmarks" list: {"name", "mesh" (a mesh file, any path),
 /// "features" (its `.lm.txt`, any path; empty or absent: none yet), "source" (plain text: where
-/// the landmarks came from)}. Errors: the mesh cannot be read (the page skips the member).
+/// the landmarks came from), optional "confidence" {name: 0..1} and "note" (a proposal's
+/// measures and flag, shown beside the landmarks)}. Errors: the mesh cannot be read (the page skips the member).
 /// A feature file that does not read against the mesh is not an error: the member is shown
 /// without landmarks and the entry's "error" says why.
 Result<LandmarkMemberData> landmark_member_data(const Json& member);

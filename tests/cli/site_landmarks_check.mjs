@@ -16,10 +16,10 @@
 // The caller (site_landmarks_test.cpp) judges the report and reads the downloads back with
 // `spherekit check --landmarks`. Prints one JSON document on stdout:
 //   {"chromium", "modes": [{"mode", "url", "error", "console_errors", "page_errors", "failed_requests",
-//     "viewer_errors", "member", "file", "vertices", "initial": [{name, vertex}], "labels": n,
+//     "viewer_errors", "member", "file", "vertices", "initial": [{name, vertex}], "labels": n, "confidences": n,
 //     "placed": {"vertex", "name", "point", "click"}, "drag": {"picks_before", "picks_after", "camera_moved",
 //     "landmarks_before", "landmarks_after"}, "moved": {"name", "from", "to"}, "renamed": {"from", "to", "vertex"},
-//     "refused_rename": {"tried", "name_after", "message"}, "final": [...], "download": {"suggested", "path"},
+//     "refused_rename": {"tried", "name_after", "message"}, "final": [...], "labels_final", "confidences_final", "download": {"suggested", "path"},
 //     "download_all": {"members", "files", "dir"}, "second": {"member", "vertices", "landmarks", "labels"}}]}
 // Exit code 0 when it ran (whatever it found), 1 when the browser could not be driven, 2 on usage errors.
 import { createServer } from 'node:http';
@@ -121,6 +121,7 @@ async function check(context, mode, url) {
     }));
     r.initial = await landmarks(page);
     r.labels = await page.locator('#landmark-canvas .landmark-label').count();
+    r.confidences = await page.locator('#landmark-list .landmark-confidence').count();
     const shot = await page.locator('#landmark-canvas').screenshot({ path: join(workDir, `${mode}_landmarks.png`) });
     r.screenshot_bytes = shot.length;
 
@@ -179,6 +180,7 @@ async function check(context, mode, url) {
 
     r.final = await landmarks(page);
     r.labels_final = await page.locator('#landmark-canvas .landmark-label').count();
+    r.confidences_final = await page.locator('#landmark-list .landmark-confidence').count();
     await page.locator('#landmark-canvas').screenshot({ path: join(workDir, `${mode}_landmarks_edited.png`) });
 
     // Download.

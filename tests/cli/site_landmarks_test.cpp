@@ -103,6 +103,10 @@ TEST_CASE("landmark editor on the results page: place, move, rename and download
     CHECK(m.at("vertices") == a.V.rows());
     CHECK(m.at("initial") == as_json(*given));
     CHECK(m.at("labels") == given->size());
+    // Each proposed landmark with the proposal's confidence; the moved one loses it (its point
+    // is the user's now), the placed one has none.
+    CHECK(m.at("confidences") == given->size());
+    CHECK(m.at("confidences_final") == given->size() - 1);
 
     // Placed at the clicked vertex, which is where the ray met the input mesh: the page's
     // vertex numbers are the input's.

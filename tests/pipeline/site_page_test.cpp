@@ -232,7 +232,8 @@ TEST_CASE("results page: the landmark editor's meshes as scripts in the input's 
   const Json site = {{"viewer_dir", viewer},
                      {"landmarks",
                       {{"members",
-                        {{{"name", "tet"}, {"mesh", in + "/tet.obj"}, {"features", in + "/tet.lm.txt"}, {"source", "given"}},
+                        {{{"name", "tet"}, {"mesh", in + "/tet.obj"}, {"features", in + "/tet.lm.txt"}, {"source", "given"},
+                          {"confidence", {{"tip", 0.25}, {"base", "not a number"}}}, {"note", "left/right undecided"}},
                          {{"name", "none yet"}, {"mesh", in + "/tet.obj"}},
                          {{"name", "bad file"}, {"mesh", in + "/tet.obj"}, {"features", in + "/bad.lm.txt"}},
                          {{"name", "gone"}, {"mesh", in + "/gone.obj"}}}}}}};
@@ -256,6 +257,10 @@ TEST_CASE("results page: the landmark editor's meshes as scripts in the input's 
   CHECK(members[0]["triangles"] == 4);
   CHECK(members[0]["landmarks"] == nlohmann::json::parse(R"([{"name":"tip","vertex":3},{"name":"base","vertex":0}])"));
   CHECK_FALSE(members[0].contains("error"));
+  CHECK(members[0]["confidence"] == nlohmann::json::parse(R"({"tip":0.25})"));
+  CHECK(members[0]["note"] == "left/right undecided");
+  CHECK_FALSE(members[1].contains("confidence"));
+  CHECK_FALSE(members[1].contains("note"));
   CHECK(members[1]["landmarks"].empty());
   CHECK_FALSE(members[1].contains("error"));
   CHECK(members[2]["landmarks"].empty());

@@ -57,6 +57,8 @@ using Json = nlohmann::ordered_json;
 ///   `.lm.txt` reader expects. "features" empty or absent: no landmarks yet. A mesh that
 ///   cannot be read is skipped with a warning; a feature file that does not read against its
 ///   mesh shows the member without landmarks and says why.
+///   Optional per member: "confidence" {name: 0..1} and "note" (a proposal's measures and
+///   left/right flag, shown beside the landmarks).
 /// - "viewer_dir" is normally absent: then $SPHEREKIT_VIEWER_DIR, else
 ///   $HOME/.cache/spherekit/viewer; the viewer files are its dist/ folder.
 ///

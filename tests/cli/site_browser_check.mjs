@@ -18,27 +18,18 @@
 // Packages are loaded from NODE_DIR/node_modules (scripts/setup_viewer.sh --browser installs
 // them); Chromium from $CHROMIUM, default /usr/bin/chromium.
 // Exit code 0 when it ran (whatever it found), 1 when the browser could not be driven, 2 on usage errors.
-import { createServer } from 'node:http';
-import { readFileSync, writeFileSync, mkdtempSync, rmSync, existsSync, statSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join, resolve, extname, sep } from 'node:path';
-import { pathToFileURL } from 'node:url';
-import { createRequire } from 'node:module';
+import { join, resolve } from 'node:path';
 import { inflateSync } from 'node:zlib';
+import { runPageChecks } from './browser_harness.mjs';
 
 const [nodeDir, pageDirArg, shotDirArg] = process.argv.slice(2);
 if (!nodeDir || !pageDirArg || !shotDirArg) {
   console.error('usage: node site_browser_check.mjs NODE_DIR PAGE_DIR SHOT_DIR');
   process.exit(2);
 }
-const pageDir = resolve(pageDirArg), shotDir = resolve(shotDirArg);
-const require = createRequire(join(nodeDir, 'package.json'));
-const { chromium } = require('playwright-core');
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
+const shotDir = resolve(shotDirArg);
 // The page's canvas background (viewer.js BACKGROUND) and how far a pixel must be from it to count.
 const BACKGROUND = [0x20, 0x25, 0x2b], THRESHOLD = 30;
-// Whole run: well under the test's budget even on a loaded machine.
-const watchdog = setTimeout(() => { console.error('site_browser_check: timed out after 240 s'); process.exit(1); }, 240000);
 
 // ---- PNG decoding (8-bit, non-interlaced: what Chromium's screenshots are), to count pixels.
 function decodePng(buf) {
@@ -87,19 +78,6 @@ function changedFraction(p, q) {
   }
   return n / (p.width * p.height);
 }
-
-// ---- a static server for PAGE_DIR
-const types = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.png': 'image/png', '.txt': 'text/plain',
-                '.glb': 'model/gltf-binary', '.json': 'application/json' };
-const server = createServer((req, res) => {
-  const path = resolve(pageDir, '.' + decodeURIComponent(new URL(req.url, 'http://x').pathname));
-  if (!(path === pageDir || path.startsWith(pageDir + sep)) || !existsSync(path) || !statSync(path).isFile()) {
-    res.writeHead(404); res.end(); return;
-  }
-  res.writeHead(200, { 'content-type': types[extname(path)] || 'application/octet-stream' });
-  res.end(readFileSync(path));
-});
-await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
 
 // Waits until the viewer has nothing pending and two more frames were drawn.
 async function settle(page) {
@@ -236,31 +214,5 @@ async function viewerChecks(page, mode, r) {
   r.viewer_errors = await page.evaluate(() => window.spherekitViewer ? window.spherekitViewer.errors : ['viewer.js did not run']);
 }
 
-const profile = mkdtempSync(join(tmpdir(), 'spherekit-site-profile-'));
-let context, code = 0;
-const report = { modes: [] };
-try {
-  context = await chromium.launchPersistentContext(profile, {
-    executablePath: chromiumPath,
-    headless: true,
-    viewport: { width: 1100, height: 900 },
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-           '--disable-background-networking', '--disable-component-update', '--disable-sync',
-           // WebGL without a GPU: ANGLE on SwiftShader, Chromium's software rasterizer.
-           '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
-  report.chromium = context.browser()?.version() ?? null;
-  report.modes.push(await check(context, 'http', `http://127.0.0.1:${server.address().port}/index.html`));
-  report.modes.push(await check(context, 'file', pathToFileURL(join(pageDir, 'index.html')).href));
-} catch (e) {
-  report.error = String(e && e.stack || e);
-  code = 1;
-} finally {
-  if (context) await context.close();
-  server.close();
-  rmSync(profile, { recursive: true, force: true });
-  clearTimeout(watchdog);
-}
-writeFileSync(join(shotDir, 'report.json'), JSON.stringify(report, null, 1));
-console.log(JSON.stringify(report, null, 1));
-process.exit(code);
+// Whole run: well under the test's budget even on a loaded machine.
+await runPageChecks({ name: 'site_browser_check', nodeDir, pageDir: pageDirArg, outDir: shotDir, seconds: 240, check });

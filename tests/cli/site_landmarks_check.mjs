@@ -22,35 +22,16 @@
 //     "refused_rename": {"tried", "name_after", "message"}, "final": [...], "labels_final", "confidences_final", "download": {"suggested", "path"},
 //     "download_all": {"members", "files", "dir"}, "second": {"member", "vertices", "landmarks", "labels"}}]}
 // Exit code 0 when it ran (whatever it found), 1 when the browser could not be driven, 2 on usage errors.
-import { createServer } from 'node:http';
-import { readFileSync, writeFileSync, mkdtempSync, mkdirSync, rmSync, existsSync, statSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join, resolve, extname, sep } from 'node:path';
-import { pathToFileURL } from 'node:url';
-import { createRequire } from 'node:module';
+import { mkdirSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { runPageChecks } from './browser_harness.mjs';
 
 const [nodeDir, pageDirArg, workDirArg] = process.argv.slice(2);
 if (!nodeDir || !pageDirArg || !workDirArg) {
   console.error('usage: node site_landmarks_check.mjs NODE_DIR PAGE_DIR WORK_DIR');
   process.exit(2);
 }
-const pageDir = resolve(pageDirArg), workDir = resolve(workDirArg);
-const require = createRequire(join(nodeDir, 'package.json'));
-const { chromium } = require('playwright-core');
-const chromiumPath = process.env.CHROMIUM || '/usr/bin/chromium';
-const watchdog = setTimeout(() => { console.error('site_landmarks_check: timed out after 180 s'); process.exit(1); }, 180000);
-
-const types = { '.html': 'text/html; charset=utf-8', '.js': 'text/javascript', '.png': 'image/png', '.txt': 'text/plain',
-                '.glb': 'model/gltf-binary', '.json': 'application/json' };
-const server = createServer((req, res) => {
-  const path = resolve(pageDir, '.' + decodeURIComponent(new URL(req.url, 'http://x').pathname));
-  if (!(path === pageDir || path.startsWith(pageDir + sep)) || !existsSync(path) || !statSync(path).isFile()) {
-    res.writeHead(404); res.end(); return;
-  }
-  res.writeHead(200, { 'content-type': types[extname(path)] || 'application/octet-stream' });
-  res.end(readFileSync(path));
-});
-await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
+const workDir = resolve(workDirArg);
 
 async function settle(page) {
   await page.waitForFunction(() => window.spherekitViewer && window.spherekitViewer.pending === 0 &&
@@ -223,31 +204,4 @@ async function check(context, mode, url) {
   return r;
 }
 
-const profile = mkdtempSync(join(tmpdir(), 'spherekit-landmarks-profile-'));
-let context, code = 0;
-const report = { modes: [] };
-try {
-  context = await chromium.launchPersistentContext(profile, {
-    executablePath: chromiumPath,
-    headless: true,
-    acceptDownloads: true,
-    viewport: { width: 1100, height: 900 },
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
-           '--disable-background-networking', '--disable-component-update', '--disable-sync',
-           '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
-  report.chromium = context.browser()?.version() ?? null;
-  report.modes.push(await check(context, 'http', `http://127.0.0.1:${server.address().port}/index.html`));
-  report.modes.push(await check(context, 'file', pathToFileURL(join(pageDir, 'index.html')).href));
-} catch (e) {
-  report.error = String(e && e.stack || e);
-  code = 1;
-} finally {
-  if (context) await context.close();
-  server.close();
-  rmSync(profile, { recursive: true, force: true });
-  clearTimeout(watchdog);
-}
-writeFileSync(join(workDir, 'report.json'), JSON.stringify(report, null, 1));
-console.log(JSON.stringify(report, null, 1));
-process.exit(code);
+await runPageChecks({ name: 'site_landmarks_check', nodeDir, pageDir: pageDirArg, outDir: workDir, seconds: 180, check });

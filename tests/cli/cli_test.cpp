@@ -480,6 +480,41 @@ TEST_CASE("bench compares with a reference measured in the same run", "[cli]") {
   CHECK(row["reference"]["efficiency"].get<double>() == Approx(row["efficiency"].get<double>()).epsilon(1e-9));
   CHECK(row["reference"]["cpu_seconds"].get<double>() > 0);
   CHECK(j["totals"]["cpu_ratio"].get<double>() > 0);
+  // Linf stretch of both maps, measured by the same evaluator: a normalised max singular
+  // value is >= 1 (the chord-area-weighted mean of the area ratios is 1), the ratio is
+  // ours / reference, and the identical stand-in gives the same Linf, so the 1.5x rule passes.
+  REQUIRE(row.contains("linf"));
+  REQUIRE(row["reference"].contains("linf"));
+  const double linf = row["linf"].get<double>(), ref_linf = row["reference"]["linf"].get<double>();
+  CHECK(linf >= 1.0);
+  CHECK(ref_linf == Approx(linf).epsilon(1e-9));
+  CHECK(row["linf_ratio"].get<double>() == Approx(linf / ref_linf).epsilon(1e-12));
+  CHECK(j["totals"]["linf_compared"] == 1);
+  CHECK(j["totals"]["worst_linf_ratio"].get<double>() == Approx(row["linf_ratio"].get<double>()).epsilon(1e-12));
+  CHECK(j["totals"]["linf_ratio_limit"].get<double>() == 1.5);
+  CHECK(j["totals"]["linf_rule_pass"] == true);
+  CHECK(j["totals"]["linf_over_limit"].empty());
+  CHECK(r.out.find("Linf rule (ours <= 1.5x the reference's): pass on 1 meshes") != std::string::npos);
+  CHECK(r.out.find("Linf ratio") != std::string::npos);
+
+  // Without a reference measured here (the blob has no recorded figures either) our Linf is
+  // still there, the reference side is left out, and our figure is the one param itself
+  // reports for its map (bench reads the written file back: 17 digits, same definition).
+  const std::string out_alone = dir + "/bench_alone.json", param_report = dir + "/param.json";
+  CliRun alone = run_cli("bench " + quote(mesh) + " --threads 1 -o " + quote(out_alone), dir);
+  INFO("stderr: " << alone.err);
+  REQUIRE(alone.exit_code == 0);
+  REQUIRE(run_cli("param " + quote(mesh) + " -o " + quote(dir + "/blob.sphere.obj") + " --threads 1 --quiet --report " +
+                      quote(param_report),
+                  dir)
+              .exit_code == 0);
+  const json alone_row = parse_json(slurp(out_alone))["rows"][0];
+  REQUIRE(alone_row.contains("linf"));
+  CHECK(alone_row["linf"].get<double>() == Approx(parse_json(slurp(param_report))["linf_stretch"].get<double>()).epsilon(1e-6));
+  CHECK(alone_row["linf"].get<double>() == Approx(linf).epsilon(1e-9));
+  CHECK_FALSE(alone_row.contains("linf_ratio"));
+  CHECK_FALSE(parse_json(slurp(out_alone))["totals"].contains("worst_linf_ratio"));
+  CHECK(alone.out.find("Linf rule") == std::string::npos);
 
   // A folder without the reference's programs: one-line error naming it, no output.
   const std::string out2 = dir + "/bench2.json";

@@ -1,4 +1,4 @@
-// `spherekit bench`: time, peak memory and efficiency of `param` per mesh, side by side
+// `spherekit bench`: time, peak memory, efficiency and Linf stretch of `param` per mesh, side by side
 // with the reference implementation: run in the same session (--reference-dir), else its
 // figures recorded in shared/docs/EVALUATION.md §4.
 //
@@ -188,32 +188,45 @@ Result<ReferenceKit> find_reference_kit(const std::string& dir, const std::strin
   return kit;
 }
 
-struct MeasuredReference {
-  ChildRun run;
+// What our evaluator measures on a written sphere map, ours or the reference's: both are
+// read back from their files and evaluated on the original mesh (for a mesh with holes, its
+// real faces only), as shared/tools/evalsphere.py does, so the two Linf figures are measured
+// the same way (EVALUATION.md §1: normalised max singular value).
+struct MapMeasures {
   double efficiency = 0, linf = 0;
   int flipped = -1;
 };
 
-Result<MeasuredReference> run_reference(const ReferenceKit& kit, const std::string& mesh, const std::string& sphere) {
+Result<MapMeasures> measure_map(const TriMesh& surface, const std::string& sphere) {
+  formats::ReadOptions lenient;
+  lenient.polygons = formats::PolygonPolicy::Triangulate;
+  auto map = formats::read_mesh(sphere, lenient);
+  if (!map.ok()) return with_file(map.status(), sphere);
+  if (map->V.rows() != surface.V.rows())
+    return Status(ErrorCode::InvalidInput, sphere + ": the sphere map has another vertex count than the mesh");
+  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics e, evaluate_sphere_map(surface, map->V));
+  return MapMeasures{e.efficiency, e.linf, e.flipped};
+}
+
+struct MeasuredReference {
+  ChildRun run;
+  MapMeasures map;
+};
+
+Result<MeasuredReference> run_reference(const ReferenceKit& kit, const TriMesh& surface, const std::string& mesh,
+                                        const std::string& sphere) {
   MeasuredReference m;
   SPHEREKIT_ASSIGN_OR_RETURN(m.run, run_program("/bin/bash", {kit.script.string(), mesh, sphere},
                                                   {"MPL_ROOT=" + kit.mpl_root.string(),
                                                    "OMP_NUM_THREADS=" + std::to_string(kit.threads)}));
   if (m.run.exit_code != 0) return m;
-  auto surface = formats::read_mesh(mesh);
-  if (!surface.ok()) return with_file(surface.status(), mesh);
-  formats::ReadOptions lenient;
-  lenient.polygons = formats::PolygonPolicy::Triangulate;
-  auto map = formats::read_mesh(sphere, lenient);
-  if (!map.ok()) return with_file(map.status(), sphere);
-  if (map->V.rows() != surface->V.rows())
-    return Status(ErrorCode::InvalidInput, sphere + ": the reference's map has another vertex count");
-  SPHEREKIT_ASSIGN_OR_RETURN(SphereMapMetrics e, evaluate_sphere_map(surface.value(), map->V));
-  m.efficiency = e.efficiency;
-  m.linf = e.linf;
-  m.flipped = e.flipped;
+  SPHEREKIT_ASSIGN_OR_RETURN(m.map, measure_map(surface, sphere));
   return m;
 }
+
+// Issue 20's quality rule beside the efficiency one: our Linf stretch at most this many
+// times the reference's on the same mesh, measured in the same run.
+constexpr double kLinfRatioLimit = 1.5;
 
 std::string ratio(double ours, double ref) { return ref > 0 ? format_text("%.2f", ours / ref) : std::string("-"); }
 
@@ -270,12 +283,13 @@ int run_bench(const BenchArgs& a) {
               kit ? ("measured in this run (" + kit->mpl_root.string() + ")").c_str()
                   : "figures recorded in EVALUATION.md (another machine)");
 
-  Table table({"mesh", "V", "F", "eff", "ref eff", "d eff", "flips", "CPU s", "ref CPU", "CPU ratio", "wall s",
-               "peak MB", "ref MB", "MB ratio", "status"});
+  Table table({"mesh", "V", "F", "eff", "ref eff", "d eff", "Linf", "ref Linf", "Linf ratio", "flips", "CPU s",
+               "ref CPU", "CPU ratio", "wall s", "peak MB", "ref MB", "MB ratio", "status"});
   Json rows = Json::array();
   double cpu_total = 0, ref_cpu_total = 0, cpu_total_with_ref = 0, wall_total = 0;
-  double worst_mb_ratio = 0, worst_eff_delta = 1e300;
-  int worst = 0, failed = 0, flipped_total = 0;
+  double worst_mb_ratio = 0, worst_eff_delta = 1e300, worst_linf_ratio = 0;
+  int worst = 0, failed = 0, flipped_total = 0, linf_compared = 0;
+  Json linf_over = Json::array();  // meshes whose Linf ratio breaks the rule
   for (size_t i = 0; i < meshes.size(); ++i) {
     const std::string& mesh = meshes[i];
     const std::string sphere = (work / (std::to_string(i) + ".sphere.obj")).string();
@@ -289,17 +303,24 @@ int run_bench(const BenchArgs& a) {
     if (!child.ok()) return print_error(child.status());
     if (cancel_requested()) return print_error(cancelled_status());
     const ChildRun& c = child.value();
+    // The original mesh, for measuring both maps with the same evaluator. Unreadable only
+    // when our run failed on it too (then the reference, if any, cannot be measured).
+    auto surface = formats::read_mesh(mesh);
     const Reference* ref = find_reference(mesh);
     Reference measured{};
+    std::optional<double> ref_linf;  // only measured in this run: EVALUATION.md records none
     if (kit) {
       // Measured side by side: replaces the recorded figures for this mesh.
-      auto r = run_reference(*kit, mesh, (work / (std::to_string(i) + ".reference.sphere.obj")).string());
+      if (!surface.ok()) return print_error(with_file(surface.status(), mesh));
+      auto r = run_reference(*kit, surface.value(), mesh,
+                             (work / (std::to_string(i) + ".reference.sphere.obj")).string());
       if (!r.ok()) return print_error(r.status());
       if (cancel_requested()) return print_error(cancelled_status());
       ref = nullptr;
       if (r->run.exit_code == 0) {
-        measured = Reference{"", r->efficiency, r->run.cpu_seconds, r->run.peak_mb};
+        measured = Reference{"", r->map.efficiency, r->run.cpu_seconds, r->run.peak_mb};
         ref = &measured;
+        ref_linf = r->map.linf;
       } else {
         std::fprintf(stderr, "[bench] the reference failed on %s (exit %d)\n", mesh.c_str(), r->run.exit_code);
       }
@@ -310,17 +331,26 @@ int run_bench(const BenchArgs& a) {
     wall_total += c.wall_seconds;
 
     Json report;
+    std::optional<MapMeasures> ours;
     if (c.exit_code == 0) {
       auto text = formats::read_file(report_path);
       if (text.ok()) report = Json::parse(text.value(), nullptr, /*allow_exceptions=*/false);
+      if (surface.ok()) {
+        auto m = measure_map(surface.value(), sphere);
+        if (m.ok())
+          ours = m.value();
+        else
+          std::fprintf(stderr, "[bench] %s\n", m.status().message().c_str());
+      }
     }
-    if (c.exit_code != 0 || report.is_discarded() || !report.is_object()) {
+    if (c.exit_code != 0 || report.is_discarded() || !report.is_object() || !ours) {
       ++failed;
       worst = worse_exit_code(worst, c.exit_code != 0 ? c.exit_code : error_code_exit_code(ErrorCode::Internal));
       row["status"] = "failed";
       table.add_row({file_name(mesh), "", "", "", ref ? format_text("%.4f", ref->efficiency) : "-", "", "",
-                     format_text("%.1f", c.cpu_seconds), ref ? format_text("%.1f", ref->cpu_seconds) : "-", "",
-                     format_text("%.1f", c.wall_seconds), format_text("%.0f", c.peak_mb), ref ? format_text("%.0f", ref->peak_mb) : "-", "",
+                     ref_linf ? format_text("%.2f", *ref_linf) : "-", "", "", format_text("%.1f", c.cpu_seconds),
+                     ref ? format_text("%.1f", ref->cpu_seconds) : "-", "", format_text("%.1f", c.wall_seconds),
+                     format_text("%.0f", c.peak_mb), ref ? format_text("%.0f", ref->peak_mb) : "-", "",
                      format_text("FAILED (exit %d)", c.exit_code)});
       rows.push_back(std::move(row));
       continue;
@@ -332,6 +362,7 @@ int run_bench(const BenchArgs& a) {
     row["V"] = report.value("V", 0);
     row["F"] = report.value("F", 0);
     row["efficiency"] = eff;
+    row["linf"] = ours->linf;
     row["flipped_faces"] = flips;
     row["winding"] = report.value("winding", 0.0);
     row["times"] = report.value("times", Json::object());
@@ -345,13 +376,22 @@ int run_bench(const BenchArgs& a) {
       worst_mb_ratio = std::max(worst_mb_ratio, c.peak_mb / ref->peak_mb);
       worst_eff_delta = std::min(worst_eff_delta, eff - ref->efficiency);
     }
+    if (ref_linf) {
+      const double linf_ratio = ours->linf / *ref_linf;
+      row["reference"]["linf"] = *ref_linf;
+      row["linf_ratio"] = linf_ratio;
+      ++linf_compared;
+      worst_linf_ratio = std::max(worst_linf_ratio, linf_ratio);
+      if (!(linf_ratio <= kLinfRatioLimit)) linf_over.push_back(file_name(mesh));
+    }
     table.add_row({file_name(mesh), std::to_string(report.value("V", 0)), std::to_string(report.value("F", 0)),
                    format_text("%.4f", eff), ref ? format_text("%.4f", ref->efficiency) : "-",
-                   ref ? format_text("%+.4f", eff - ref->efficiency) : "-", std::to_string(flips),
-                   format_text("%.2f", c.cpu_seconds), ref ? format_text("%.1f", ref->cpu_seconds) : "-",
-                   ref ? ratio(c.cpu_seconds, ref->cpu_seconds) : "-", format_text("%.2f", c.wall_seconds),
-                   format_text("%.0f", c.peak_mb), ref ? format_text("%.0f", ref->peak_mb) : "-",
-                   ref ? ratio(c.peak_mb, ref->peak_mb) : "-", "ok"});
+                   ref ? format_text("%+.4f", eff - ref->efficiency) : "-", format_text("%.2f", ours->linf),
+                   ref_linf ? format_text("%.2f", *ref_linf) : "-", ref_linf ? ratio(ours->linf, *ref_linf) : "-",
+                   std::to_string(flips), format_text("%.2f", c.cpu_seconds),
+                   ref ? format_text("%.1f", ref->cpu_seconds) : "-", ref ? ratio(c.cpu_seconds, ref->cpu_seconds) : "-",
+                   format_text("%.2f", c.wall_seconds), format_text("%.0f", c.peak_mb),
+                   ref ? format_text("%.0f", ref->peak_mb) : "-", ref ? ratio(c.peak_mb, ref->peak_mb) : "-", "ok"});
     rows.push_back(std::move(row));
   }
 
@@ -364,6 +404,13 @@ int run_bench(const BenchArgs& a) {
                 "%+.4f, worst memory ratio %.2f",
                 cpu_total_with_ref, ref_cpu_total, cpu_total_with_ref / ref_cpu_total, worst_eff_delta, worst_mb_ratio);
   std::printf("\n%d failed, %d flipped faces in total\n", failed, flipped_total);
+  if (linf_compared > 0) {
+    std::string over;
+    for (const Json& name : linf_over) over += (over.empty() ? "" : ", ") + name.get<std::string>();
+    std::printf("Linf rule (ours <= %.1fx the reference's): %s on %d meshes, worst ratio %.2f%s\n", kLinfRatioLimit,
+                linf_over.empty() ? "pass" : "FAIL", linf_compared, worst_linf_ratio,
+                linf_over.empty() ? "" : ("; above on " + over).c_str());
+  }
 
   if (!a.output.empty()) {
     Json j;
@@ -382,6 +429,13 @@ int run_bench(const BenchArgs& a) {
       totals["worst_efficiency_delta"] = worst_eff_delta;
       totals["worst_peak_mb_ratio"] = worst_mb_ratio;
     }
+    if (linf_compared > 0) {
+      totals["linf_compared"] = linf_compared;
+      totals["worst_linf_ratio"] = worst_linf_ratio;
+      totals["linf_ratio_limit"] = kLinfRatioLimit;
+      totals["linf_rule_pass"] = linf_over.empty();
+      totals["linf_over_limit"] = std::move(linf_over);
+    }
     j["totals"] = std::move(totals);
     if (Status s = write_json_atomic(a.output, j); !s.ok()) return print_error(s);
     std::printf("wrote %s\n", a.output.c_str());
@@ -394,12 +448,14 @@ int run_bench(const BenchArgs& a) {
 void register_bench(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   CLI::App* cmd = add_command(
-      app, "bench", "Time, memory and efficiency of param per mesh vs. the reference",
+      app, "bench", "Time, memory, efficiency and Linf of param per mesh vs. the reference",
       "Benchmark `param`: run it on each mesh in a child process (so CPU time and peak memory are\n"
-      "per mesh) and print a table of vertices, faces, efficiency, flipped faces, CPU and wall\n"
-      "seconds and peak MB, with the reference implementation's figures and the ratios\n"
-      "ours/reference: measured in the same run with --reference-dir (alternating ours and its\n"
-      "runs mesh by mesh), else the figures recorded in EVALUATION.md §4 on another machine. Default meshes: the dev meshes (knight ... igea.ply) found in\n"
+      "per mesh) and print a table of vertices, faces, efficiency, Linf stretch, flipped faces,\n"
+      "CPU and wall seconds and peak MB, with the reference implementation's figures and the\n"
+      "ratios ours/reference: measured in the same run with --reference-dir (alternating ours and\n"
+      "its runs mesh by mesh; both maps' Linf by the same evaluator, with a pass/fail line for\n"
+      "Linf <= 1.5x the reference's), else the figures recorded in EVALUATION.md §4 on another\n"
+      "machine (no Linf there). Default meshes: the dev meshes (knight ... igea.ply) found in\n"
       "--meshes-dir, else in $SPHEREKIT_SHARED_DIR/meshes or a shared/meshes folder above the\n"
       "working directory or the executable; else the built-in samples.",
       "  spherekit bench -o bench.json\n"

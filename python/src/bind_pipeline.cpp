@@ -51,7 +51,7 @@ pipeline::ConvertOptions convert_options(int size, int lods, const std::string& 
 
 // The convert options as keyword arguments, one spelling for both convert functions.
 #define SPHEREKIT_PY_CONVERT_ARGS                                                                       \
-  pyb::kw_only(), pyb::arg("size") = 257, pyb::arg("lods") = 0, pyb::arg("lod_mode") = "uniform",      \
+  pyb::kw_only(), pyb::arg("size") = 257, pyb::arg("lods") = 0, pyb::arg("lod_mode") = "adaptive",      \
       pyb::arg("cage") = 0, pyb::arg("cage_tile") = 17, pyb::arg("displacement") = "scalar",           \
       pyb::arg("psnr_samples") = pipeline::ConvertOptions{}.psnr_samples, pyb::arg("threads") = 0,     \
       pyb::arg("progress") = pyb::none()

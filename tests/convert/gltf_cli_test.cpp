@@ -26,7 +26,7 @@ TEST_CASE("spherekit convert --lods writes Draco glTF levels and reports their s
   test::write_blob_inputs(dir);
   const test::CliRun r = test::run_cli(SPHEREKIT_EXE,
                                        "convert " + quote(dir + "/blob.obj") + " " + quote(dir + "/blob.sphere.obj") +
-                                           " -o " + quote(dir + "/blob.exr") + " --gi 33 --lods 3 --report " +
+                                           " -o " + quote(dir + "/blob.exr") + " --gi 33 --lods 3 --lod-mode uniform --report " +
                                            quote(dir + "/blob.json") + " --psnr-samples 20000",
                                        cap);
   INFO(r.err);

@@ -95,8 +95,8 @@ void register_convert(CLI::App& app) {
                   "points sampled per direction for the PSNR (0: skip it; default 400000)");
   cmd->add_option("--lods", args->options.lods, "also write this many glTF levels of detail (default 0: none)");
   cmd->add_option("--lod-mode", args->options.lod_mode,
-                  "glTF levels: uniform (coarser geometry images, default) or adaptive (quadric simplification "
-                  "of the remesh; a collection's members share each level's connectivity)")
+                  "glTF levels: adaptive (quadric simplification of the remesh, default; a collection's members "
+                  "share each level's connectivity) or uniform (coarser geometry images)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, convert::LodMode>{
           {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}}));
   cmd->add_flag("!--no-lod-normals", args->options.lod_normals,

@@ -14,6 +14,7 @@
 
 #include <Eigen/SVD>
 
+#include "detail/feature_warp.h"
 #include "detail/path_network.h"
 #include "detail/rotation.h"
 #include "detail/sphere_embedding.h"
@@ -282,10 +283,13 @@ constexpr const char* kSteinerFailure = "a face stays flipped after removing the
 
 // `steiner_failure` is set when the attempt failed only because a face stayed flipped after
 // the Steiner vertices were removed: the one failure another network variant may avoid.
+// `network_subset` (indices into the features; empty: all) are the features the path network
+// triangulates; the others are then carried onto their targets by the feature warp
+// (detail/feature_warp.h: dense feature sets).
 Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const std::vector<int>& feature_vertices,
                                                    const std::vector<Eigen::Vector3d>& targets_in,
                                                    const ConstrainedParamOptions& options, const ProgressFn& progress,
-                                                   bool* steiner_failure) {
+                                                   bool* steiner_failure, const std::vector<int>& network_subset) {
   const auto t_start = std::chrono::steady_clock::now();
   ConstrainedParamResult result;
   const SphereParamOptions& so = options.sphere;
@@ -427,7 +431,20 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     }
     result.network.auxiliary_features = static_cast<int>(fv.size()) - k_given;
   }
-  const int k = static_cast<int>(fv.size());
+  // The features the network triangulates: all, or the dense set's subset (never with
+  // auxiliary features, which only sparse sets get).
+  std::vector<int> net_fv = fv;
+  std::vector<Eigen::Vector3d> net_targets = targets;
+  const bool warp = !network_subset.empty() && !need_unconstrained;
+  if (warp) {
+    net_fv.clear();
+    net_targets.clear();
+    for (int i : network_subset) {
+      net_fv.push_back(fv[static_cast<size_t>(i)]);
+      net_targets.push_back(targets[static_cast<size_t>(i)]);
+    }
+  }
+  const int k = static_cast<int>(net_fv.size());
 
   // 3.-4. Path network on the normalized mesh Pn (made above).
   auto t0 = std::chrono::steady_clock::now();
@@ -438,7 +455,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   no.sidedness = options.sidedness;
   no.unswirl = options.unswirl;
   no.edge_flips = options.edge_flips;
-  SPHEREKIT_ASSIGN_OR_RETURN(detail::PathNetwork net, detail::build_path_network(Pn, closed.F, fv, targets, no, progress));
+  SPHEREKIT_ASSIGN_OR_RETURN(detail::PathNetwork net, detail::build_path_network(Pn, closed.F, net_fv, net_targets, no, progress));
   result.times.network = seconds_since(t0);
   auto& rep = result.network;
   rep.paths = static_cast<int>(net.paths.size());
@@ -448,7 +465,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   rep.edge_flips = net.edge_flips;
   rep.deferred = net.deferred;
   rep.steiner_vertices = static_cast<int>(net.steiner_parent.size());
-  rep.arc_targets = targets;
+  rep.arc_targets = net_targets;
   for (const auto& p : net.paths) {
     rep.arcs.push_back({p.a, p.b});
     std::vector<Eigen::Vector3d> line;
@@ -467,7 +484,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     for (int c = 0; c < 3; ++c) Fnet(f, c) = net.F[static_cast<size_t>(f)][static_cast<size_t>(c)];
   ProgressiveMeshOptions pmo;
   pmo.keep_vertices.assign(static_cast<size_t>(nn), 0);
-  for (int v : fv) pmo.keep_vertices[static_cast<size_t>(v)] = 1;
+  for (int v : net_fv) pmo.keep_vertices[static_cast<size_t>(v)] = 1;
   for (const auto& p : net.paths)
     for (size_t i = 1; i < p.verts.size(); ++i) pmo.constraint_edges.push_back({p.verts[i - 1], p.verts[i]});
   pmo.target_vertices = k;
@@ -493,8 +510,8 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   in.base_positions = RowMat3d::Zero(nn, 3);
   in.fixed.assign(static_cast<size_t>(nn), 0);
   for (int i = 0; i < k; ++i) {
-    in.base_positions.row(fv[static_cast<size_t>(i)]) = targets[static_cast<size_t>(i)].transpose();
-    in.fixed[static_cast<size_t>(fv[static_cast<size_t>(i)])] = 1;
+    in.base_positions.row(net_fv[static_cast<size_t>(i)]) = net_targets[static_cast<size_t>(i)].transpose();
+    in.fixed[static_cast<size_t>(net_fv[static_cast<size_t>(i)])] = 1;
   }
   // The network mesh gets the full final passes although another runs on the input
   // connectivity below: a map relaxed only coarse-to-fine keeps needle-shaped regions along
@@ -508,12 +525,12 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   //    long as each split edge's quad stays convex on the sphere (checked exactly).
   RowMat3d S = Snet.topRows(n);
   std::vector<char> fixed(static_cast<size_t>(n), 0);
-  for (int v : fv) fixed[static_cast<size_t>(v)] = 1;
+  for (int v : net_fv) fixed[static_cast<size_t>(v)] = 1;
   if (has_steiner) {
     // Rarely, a split edge's quad is not convex on the sphere and a merged face flips: the
     // neighbourhood is untangled (features stay fixed), then the final pass smooths it out.
     std::vector<char> fixed_net(static_cast<size_t>(nn), 0);
-    for (int v : fv) fixed_net[static_cast<size_t>(v)] = 1;
+    for (int v : net_fv) fixed_net[static_cast<size_t>(v)] = 1;
     RowMat3d Sw = Snet;
     int untangled = remove_steiner_vertices(net, fixed_net, &Sw);
     if (untangled < 0) {
@@ -531,6 +548,23 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     }
     RowMatXd P = Pn;
     SPHEREKIT_RETURN_IF_ERROR(optimize_in_place(P, closed.F, w, sw, fixed, settings, progress, &S));
+  }
+  if (warp) {
+    // 8. Dense sets: the features outside the network's subset flow onto their targets
+    //    (bijective at every step, exact predicate), then the final pass with all fixed.
+    detail::WarpStats ws;
+    SPHEREKIT_RETURN_IF_ERROR(detail::warp_features_to_targets(Pn, closed.F, fv, targets, progress, &S, &ws));
+    result.network.warped_features = static_cast<int>(fv.size()) - k;
+    result.network.warp_steps = ws.steps;
+    std::vector<double> w(static_cast<size_t>(nf), 1.0), sw(static_cast<size_t>(nf), 0.0);
+    for (int f = filled.original_faces; f < nf; ++f) {
+      w[static_cast<size_t>(f)] = so.hole_weight;
+      sw[static_cast<size_t>(f)] = so.hole_shape_weight;
+    }
+    std::vector<char> all_fixed(static_cast<size_t>(n), 0);
+    for (int v : fv) all_fixed[static_cast<size_t>(v)] = 1;
+    RowMatXd P = Pn;
+    SPHEREKIT_RETURN_IF_ERROR(optimize_in_place(P, closed.F, w, sw, all_fixed, settings, progress, &S));
   }
   result.times.refine = seconds_since(t0);
   SPHEREKIT_RETURN_IF_ERROR(finish_measure(S, fv));
@@ -550,11 +584,32 @@ Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& me
   const double factors[] = {1.0, 0.75, 1.5, 0.6, 2.5};
   Status last;
   int attempt = 0;
+  // Dense sets (detail/feature_warp.h): first a network on a well-spread subset and the warp
+  // for the rest; only if that fails, the network over all features as for sparse sets.
+  if (static_cast<int>(feature_vertices.size()) > detail::kDenseFeatureThreshold) {
+    const std::vector<int> subset = detail::spread_subset(targets, detail::kDenseNetworkFeatures);
+    for (double f : factors) {
+      ConstrainedParamOptions o = options;
+      o.steiner_penalty = std::max(1.05, options.steiner_penalty * f);
+      bool steiner_failure = false;
+      Result<ConstrainedParamResult> r =
+          constrained_attempt(mesh, feature_vertices, targets, o, progress, &steiner_failure, subset);
+      ++attempt;
+      if (r.ok()) {
+        r.value().network.attempts = attempt;
+        return r;
+      }
+      if (r.status().code() == ErrorCode::Cancelled || r.status().code() == ErrorCode::InvalidInput ||
+          r.status().code() == ErrorCode::InvalidArgument)
+        return r.status();
+      if (!steiner_failure) break;  // the warp failed: another Steiner cost will not help
+    }
+  }
   for (double f : factors) {
     ConstrainedParamOptions o = options;
     o.steiner_penalty = std::max(1.05, options.steiner_penalty * f);
     bool steiner_failure = false;
-    Result<ConstrainedParamResult> r = constrained_attempt(mesh, feature_vertices, targets, o, progress, &steiner_failure);
+    Result<ConstrainedParamResult> r = constrained_attempt(mesh, feature_vertices, targets, o, progress, &steiner_failure, {});
     ++attempt;
     if (r.ok()) {
       r.value().network.attempts = attempt;

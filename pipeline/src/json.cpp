@@ -94,7 +94,7 @@ Json constrained_measures_json(const ConstrainedParamResult& r) {
 }
 
 Json feature_network_json(const FeatureNetworkReport& n) {
-  return Json{{"auxiliary_features", n.auxiliary_features},
+  Json j{{"auxiliary_features", n.auxiliary_features},
               {"paths", n.paths},
               {"total_path_length", n.total_length},
               {"max_length_ratio", n.max_ratio},
@@ -104,6 +104,12 @@ Json feature_network_json(const FeatureNetworkReport& n) {
               {"steiner_vertices", n.steiner_vertices},
               {"flips_untangled", n.flips_after_steiner_removal},
               {"attempts", n.attempts}};
+  // Dense feature sets only (constrained_param.h), so sparse sets' reports keep their bytes.
+  if (n.warped_features > 0) {
+    j["warped_features"] = n.warped_features;
+    j["warp_steps"] = n.warp_steps;
+  }
+  return j;
 }
 
 Json sphere_param_result_json(const SphereParamResult& r) {

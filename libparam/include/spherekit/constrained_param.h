@@ -41,6 +41,11 @@ struct FeatureNetworkReport {
   int auxiliary_features = 0;     ///< extra features added (fewer than 4, or one-sided targets)
   int attempts = 1;               ///< network variants tried (Steiner cost varied on failure)
   int flips_after_steiner_removal = 0;  ///< input faces flipped when Steiner vertices were dropped (then untangled)
+  /// Dense feature sets (more than 32): the network links a well-spread subset of 24 and the
+  /// other features are carried onto their targets by a bijective flow of the sphere; how
+  /// many, in how many steps (0 and 0 for sparse sets).
+  int warped_features = 0;
+  int warp_steps = 0;
   std::vector<std::vector<Eigen::Vector3d>> polylines;  ///< each path on the surface (input coordinates)
   std::vector<std::array<int, 2>> arcs;  ///< each path's features (indices; auxiliary ones after the given)
   std::vector<Eigen::Vector3d> arc_targets;  ///< sphere points of all features, given then auxiliary

@@ -1,0 +1,159 @@
+// Dense feature sets (issue 19; the paper's abstract: "works well with either sparse or dense
+// sets of constraints"). Above 32 features the constrained stage routes its path network
+// through a well-spread subset and carries the others onto their targets with the feature
+// warp (detail/feature_warp.h); these tests check that it gives complete, bijective maps with
+// every feature exactly on target, that the warp refuses what no flow can do, and that the
+// result does not depend on the thread count.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "dense_landmarks.h"
+#include "detail/feature_warp.h"
+#include "map_checks.h"
+#include "spherekit/consistent_param.h"
+#include "spherekit/constrained_param.h"
+#include "spherekit/metrics.h"
+#include "spherekit/sphere_param.h"
+#include "test_meshes.h"
+#include "test_paths.h"
+
+using namespace spherekit;
+
+namespace spherekit::test {
+TriMesh read_shared_mesh(const std::string& path);  // check_mesh_test.cpp
+}
+
+namespace {
+
+double angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+// Targets for a dense set on one mesh: its unconstrained map's feature images, each turned by
+// a smooth, feature-dependent twist (as another member's map would place them), so the
+// constrained map has to move every feature.
+std::vector<Eigen::Vector3d> twisted_targets(const RowMat3d& S, const std::vector<int>& fv, double amount) {
+  std::vector<Eigen::Vector3d> t;
+  for (int v : fv) {
+    const Eigen::Vector3d p = S.row(v).transpose();
+    const Eigen::Vector3d axis(0.3, 1, 0.2);
+    const double a = amount * std::sin(3 * p.z() + 1);
+    t.push_back(Eigen::AngleAxisd(a, axis.normalized()) * p);
+  }
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("feature warp carries features onto their targets bijectively, or refuses and leaves the map",
+          "[param][constrained][dense]") {
+  const TriMesh m = test::icosphere(3);  // 642 vertices on the unit sphere: S = V is a bijection
+  RowMat3d S = m.V;
+  std::vector<int> fv;
+  for (int v = 0; v < m.V.rows(); v += 9) fv.push_back(v);  // 72 features
+  SECTION("a smooth displacement") {
+    const auto t = twisted_targets(S, fv, 0.15);
+    detail::WarpStats st;
+    REQUIRE(detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &S, &st).ok());
+    CHECK(count_flipped_faces(m.F, S) == 0);
+    double worst = 0;
+    for (size_t j = 0; j < fv.size(); ++j) worst = std::max(worst, angle(S.row(fv[j]).transpose(), t[j]));
+    CHECK(worst < 1e-12);  // snapped onto the (normalized) targets
+    CHECK(st.steps > 0);
+    test::require_valid_map(m, S);
+  }
+  SECTION("two neighbouring features swapped: no flow of the sphere does it without a fold") {
+    std::vector<Eigen::Vector3d> t;
+    for (int v : fv) t.push_back(S.row(v).transpose());
+    // The two closest features trade places; everything else stays.
+    size_t a = 0, b = 1;
+    for (size_t i = 0; i < fv.size(); ++i)
+      for (size_t j = i + 1; j < fv.size(); ++j)
+        if (angle(t[i], t[j]) < angle(t[a], t[b])) a = i, b = j;
+    std::swap(t[a], t[b]);
+    const RowMat3d before = S;
+    const Status s = detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &S);
+    CHECK(s.code() == ErrorCode::SolverFailed);
+    CHECK(S == before);
+  }
+}
+
+TEST_CASE("spread subset: well-spread, deterministic, sorted", "[param][constrained][dense]") {
+  const TriMesh m = test::icosphere(2);
+  std::vector<Eigen::Vector3d> t;
+  for (int v = 0; v < m.V.rows(); ++v) t.push_back(m.V.row(v).transpose());
+  const auto s = detail::spread_subset(t, 24);
+  REQUIRE(s.size() == 24);
+  CHECK(std::is_sorted(s.begin(), s.end()));
+  CHECK(std::adjacent_find(s.begin(), s.end()) == s.end());
+  double closest = 10;
+  for (size_t i = 0; i < s.size(); ++i)
+    for (size_t j = i + 1; j < s.size(); ++j) closest = std::min(closest, angle(t[static_cast<size_t>(s[i])], t[static_cast<size_t>(s[j])]));
+  // 24 points on the sphere cannot all be farther apart than ~0.75 rad; farthest-point
+  // sampling keeps at least half of the best spacing.
+  CHECK(closest > 0.35);
+  CHECK(detail::spread_subset(t, 24) == s);
+}
+
+TEST_CASE("dense feature sets on a generated mesh: complete, bijective, exact, same bits for any thread count",
+          "[param][constrained][dense]") {
+  const TriMesh m = test::random_blob(4, 7);  // 2562 vertices
+  SphereParamOptions uo;
+  uo.effort = 0;
+  auto u = parameterize_sphere(m, uo);
+  REQUIRE(u.ok());
+  const int k = GENERATE(48, 96);
+  CAPTURE(k);
+  const auto sets = test::farthest_point_landmarks(m, {}, k);
+  const std::vector<int>& fv = sets[0];
+  REQUIRE(static_cast<int>(fv.size()) == k);
+  const auto t = twisted_targets(u->map.S, fv, 0.2);
+  ConstrainedParamOptions o;
+  o.sphere.effort = 0;
+  o.sphere.threads = 1;
+  auto r1 = parameterize_sphere_constrained(m, fv, t, o);
+  REQUIRE(r1.ok());
+  CHECK(r1->flipped_faces == 0);
+  CHECK(r1->max_feature_angle < 1e-9);
+  CHECK(std::abs(r1->winding - 1) < 1e-9);
+  CHECK(r1->network.warped_features == k - detail::kDenseNetworkFeatures);
+  CHECK(r1->network.paths == 3 * detail::kDenseNetworkFeatures - 6);
+  test::require_valid_map(m, r1->map.S);
+  o.sphere.threads = 2;
+  auto r2 = parameterize_sphere_constrained(m, fv, t, o);
+  REQUIRE(r2.ok());
+  CHECK(r2->map.S == r1->map.S);
+}
+
+TEST_CASE("shared faust5k: 64 dense landmarks, 2 members, give a complete consistent collection",
+          "[param][consistent][dense][shared][slow]") {
+  SPHEREKIT_REQUIRE_SHARED_MESHES(meshes);
+  const std::string fam = meshes + "/families/faust5k/";
+  const TriMesh a = test::read_shared_mesh(fam + "tr_reg_000.obj");
+  const TriMesh b = test::read_shared_mesh(fam + "tr_reg_013.obj");
+  const auto ca = test::read_int_list(fam + "tr_reg_000.corr.txt"), cb = test::read_int_list(fam + "tr_reg_013.corr.txt");
+  REQUIRE(!ca.empty());
+  REQUIRE(ca.size() == cb.size());
+  const auto sets = test::farthest_point_landmarks(a, {test::carry_through_samples(ca, cb)}, 64);
+  REQUIRE(sets[0].size() == 64);
+  INFO("fewest edges between two landmarks: " << test::min_hops_between(a, sets[0]) << " on 000, "
+                                              << test::min_hops_between(b, sets[1]) << " on 013");
+  ConsistentParamOptions o;
+  o.threads = 2;
+  auto r = parameterize_consistent({a, b}, sets, o);
+  REQUIRE(r.ok());
+  CHECK(r->refinement_failure.empty());  // no step fell back
+  CHECK(r->joint_flips == 0);
+  for (int i = 0; i < 2; ++i) {
+    CAPTURE(i);
+    const auto& m = r->maps[static_cast<size_t>(i)];
+    CHECK(m.flipped_faces == 0);
+    CHECK(m.max_feature_angle < 1e-9);
+    CHECK(std::abs(m.winding - 1) < 1e-9);
+    test::require_valid_map(i == 0 ? a : b, m.map.S);
+  }
+}

@@ -587,22 +587,25 @@ Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& me
   // Dense sets (detail/feature_warp.h): first a network on a well-spread subset and the warp
   // for the rest; only if that fails, the network over all features as for sparse sets.
   if (static_cast<int>(feature_vertices.size()) > detail::kDenseFeatureThreshold) {
-    const std::vector<int> subset = detail::spread_subset(targets, detail::kDenseNetworkFeatures);
-    for (double f : factors) {
-      ConstrainedParamOptions o = options;
-      o.steiner_penalty = std::max(1.05, options.steiner_penalty * f);
-      bool steiner_failure = false;
-      Result<ConstrainedParamResult> r =
-          constrained_attempt(mesh, feature_vertices, targets, o, progress, &steiner_failure, subset);
-      ++attempt;
-      if (r.ok()) {
-        r.value().network.attempts = attempt;
-        return r;
+    // Another subset gives another network, whose Steiner vertices lie elsewhere: a few
+    // subset sizes, each with three Steiner costs.
+    for (int size : detail::kDenseNetworkSizes) {
+      const std::vector<int> subset = detail::spread_subset(targets, size);
+      for (double f : {factors[0], factors[1], factors[2]}) {
+        ConstrainedParamOptions o = options;
+        o.steiner_penalty = std::max(1.05, options.steiner_penalty * f);
+        bool steiner_failure = false;
+        Result<ConstrainedParamResult> r =
+            constrained_attempt(mesh, feature_vertices, targets, o, progress, &steiner_failure, subset);
+        ++attempt;
+        if (r.ok()) {
+          r.value().network.attempts = attempt;
+          return r;
+        }
+        const ErrorCode c = r.status().code();
+        if (c == ErrorCode::Cancelled || c == ErrorCode::InvalidInput || c == ErrorCode::InvalidArgument) return r.status();
+        if (!steiner_failure) break;  // the warp failed: another Steiner cost will not help this subset
       }
-      if (r.status().code() == ErrorCode::Cancelled || r.status().code() == ErrorCode::InvalidInput ||
-          r.status().code() == ErrorCode::InvalidArgument)
-        return r.status();
-      if (!steiner_failure) break;  // the warp failed: another Steiner cost will not help
     }
   }
   for (double f : factors) {

@@ -21,8 +21,9 @@ namespace spherekit::detail {
 
 /// Above this many features the constrained stage routes its path network through a subset.
 constexpr int kDenseFeatureThreshold = 32;
-/// Size of that subset.
-constexpr int kDenseNetworkFeatures = 24;
+/// Size of that subset: the first that works of these.
+constexpr int kDenseNetworkSizes[] = {24, 16, 32};
+constexpr int kDenseNetworkFeatures = kDenseNetworkSizes[0];
 
 /// `count` indices of well-spread targets: farthest-point samples on the sphere (angles),
 /// starting with target 0, ties to the lower index. Sorted ascending.

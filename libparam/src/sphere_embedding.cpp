@@ -142,9 +142,15 @@ class Refiner {
           return Status(ErrorCode::Cancelled, "cancelled during refinement");
       }
     }
-    // Final pass at full resolution on exactly the measured energy (no accordion split).
+    // Final pass at full resolution on the measured energy: every face on its chord
+    // triangle, except a face whose chord plane passes within a quarter of the radius of the
+    // centre (a spherical triangle wider than 75 degrees, wider than a regular
+    // tetrahedron's faces: at full resolution, only a sliver lying along a great circle).
+    // Such an "accordion" face has a fat chord triangle, so the measured stretch does not
+    // see it collapse; without the split, generated limb shapes ended with faces of sphere
+    // area ~1e-16 (degenerate for evalsphere.py), one step from a flip (issue 20).
     OptimizerSettings final_settings = s_;
-    final_settings.split_distance = 0.0;
+    final_settings.split_distance = 0.25;
     final_settings.global_iter = s_.final_iter;
     SPHEREKIT_RETURN_IF_ERROR(optimize_level(final_settings));
     *S = st_.S;

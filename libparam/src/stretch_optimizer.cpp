@@ -7,7 +7,8 @@
 //
 // Energy of a face with sphere corners q0,q1,q2 (its chord triangle is the domain) and
 // surface corners p0,p1,p2, per model with the surface rescaled to area 4 pi:
-//   E_f = (A_f / A) * [ (a' + c')/2 + w * min(a', c')^-3 ]
+//   E_f = (A_f / A) * [ (a' + c')/2 + w * min(a', c')^-3 ]   (the last term averaged over
+//   the three edge frames, see cruft_term)
 // where a' = |dP/ds|^2, c' = |dP/dt|^2 in an orthonormal frame of the chord triangle.
 // The first term is Sander et al.'s squared L2 stretch weighted by surface area (the
 // quantity the efficiency measures); the second keeps sphere triangles from ballooning over
@@ -272,6 +273,29 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring) {
 
 namespace {
 
+// Praun & Hoppe's anti-cruft term (REFERENCE.md §2.4): w * min(a, c)^-3, a and c the squared
+// stretches along and across one edge of the domain triangle. The reference takes the frame
+// of the face's first edge, so its term depends on how the face is numbered; here it is the
+// mean over the three edge frames, which is independent of numbering (every corner of a face
+// optimizes the same function) and of the reference's size. Along edge k, a_k = |d_k|^2 /
+// |e_k|^2 (surface over domain edge length, squared) and c_k = T - a_k, since a + c = |J|_F^2
+// = T in every orthonormal frame. Why not the smallest squared singular value g (used
+// before): g <= min(a_k, c_k) for every k, so at the reference's weight g^-3 was a stronger
+// term than the weight was chosen for, up to several times on anisotropic maps (thin limbs),
+// where it held the sphere back from the measured optimum (issue 20, measured side by side
+// with the reference at one thread: generated limb shapes standing 0.3359 -> 0.3454 and
+// quadruped 0.3153 -> 0.3243, the reference 0.3352 and 0.3176; armadillo 0.4170 -> 0.4235,
+// horse 0.3934 -> 0.4005, the reference 0.4127 and 0.3928).
+inline double cruft_term(double T, double a1, double a2, double a3, double reg_weight) {
+  double sum = 0;
+  for (double a : {a1, a2, a3}) {
+    const double m = std::min(a, T - a);
+    if (!(m > 0)) return kInf;
+    sum += 1 / (m * m * m);
+  }
+  return reg_weight * sum / 3;
+}
+
 // Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, formed explicitly.
 inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                            const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
@@ -288,11 +312,10 @@ inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
   Eigen::Vector3d Ss = d1 / l1;
   Eigen::Vector3d St = (d2 - e2u * Ss) / h;
   double a = Ss.squaredNorm() * scale, c = St.squaredNorm() * scale, b = Ss.dot(St) * scale;
-  // Smallest squared singular value (rotation-invariant, as in gram_energy).
   double T = a + c, D = a * c - b * b;
-  double disc = T * T - 4 * D;
-  double mn = D > 0 ? 2 * D / (T + std::sqrt(disc > 0 ? disc : 0.0)) : 0.0;
-  double reg = mn > 0 ? reg_weight / (mn * mn * mn) : kInf;
+  const Eigen::Vector3d e3 = e2 - e1, d3 = d2 - d1;
+  double reg = cruft_term(T, a, scale * d2.squaredNorm() / e2.squaredNorm(),
+                          scale * d3.squaredNorm() / e3.squaredNorm(), reg_weight);
   double area = 0.5 * d1.cross(d2).norm();
   double e = weight * (area + floor) * (0.5 * (a + c) + reg);
   if (shape_weight != 0) e += D > 0 ? 0.5 * shape_weight * (0.5 * T / std::sqrt(D)) : kInf;
@@ -338,19 +361,18 @@ inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, 
   const double four_a2 = E11 * E22 - E12 * E12;  // (2 A_dom)^2
   if (!(four_a2 > 1e-24 * E11 * E22)) return kInf;
   const double T = gram_frobenius_numerator(E11, E22, E12, s[11], s[12], s[13]) * (scale / four_a2);
-  // The regularizer needs the smaller stretch; the reference takes min(a, c) in a frame
-  // along one edge, which depends on which corner is moving and so makes every vertex
-  // optimize a slightly different function (it can stall). We use the rotation-invariant
-  // smallest squared singular value g = 2 D / (T + sqrt(T^2 - 4 D)), D = det(J^T J) =
-  // (A_surf / A_dom)^2; g <= min(a, c) in any frame.
-  const double D = 4 * s[14] * s[14] * (scale * scale / four_a2);
-  const double disc = T * T - 4 * D;
-  const double g = 2 * D / (T + std::sqrt(disc > 0 ? disc : 0.0));
-  if (!(g > 0)) return kInf;
-  const double g3 = g * g * g;
-  double e = s[9] * (s[14] + s[10]) * (0.5 * T + reg_weight / g3);
-  // Scale-free shape term (MIPS, (s1^2 + s2^2) / (2 s1 s2) = T / (2 sqrt D), >= 1).
-  if (s[15] != 0) e += s[15] * (0.5 * T / std::sqrt(D));
+  // The anti-cruft term along the three edges: domain edges e1, e2, e2 - e1 and surface
+  // edges d1, d2, d2 - d1, from the Gram entries.
+  const double reg = cruft_term(T, scale * s[11] / E11, scale * s[12] / E22,
+                                scale * (s[11] + s[12] - 2 * s[13]) / (E11 + E22 - 2 * E12), reg_weight);
+  if (!std::isfinite(reg)) return kInf;
+  double e = s[9] * (s[14] + s[10]) * (0.5 * T + reg);
+  // Scale-free shape term (MIPS, (s1^2 + s2^2) / (2 s1 s2) = T / (2 sqrt D), >= 1), D =
+  // det(J^T J) = (A_surf / A_dom)^2.
+  if (s[15] != 0) {
+    const double D = 4 * s[14] * s[14] * (scale * scale / four_a2);
+    e += D > 0 ? s[15] * (0.5 * T / std::sqrt(D)) : kInf;
+  }
   return e;
 }
 }  // namespace

@@ -104,6 +104,43 @@ std::vector<Shape> shapes() {
     limb(s, {0, 0, 0.45}, {0.1, 0.1, 1}, 0.8, 0.025, 0.012, 4, {0.8, 0, 0});
     out.push_back(s);
   }
+  {  // Hand: a flat palm with five fingers of two or three bending segments (fingers of scans).
+    Shape s{"hand", {0.45, 0.4, 0.12}, {}, 0.05};
+    for (int i = 0; i < 4; ++i) {
+      double y = -0.27 + 0.18 * i;
+      limb(s, {0.35, y, 0}, {1, 0.05 * (i - 1.5), 0}, 0.55 + 0.08 * (i % 3), 0.06, 0.045, 3, {0, 0, -0.5});
+    }
+    limb(s, {0.1, -0.35, 0}, {0.5, -1, 0}, 0.45, 0.07, 0.05, 2, {0.6, 0, -0.2});  // thumb
+    limb(s, {-0.4, 0, 0}, {-1, 0, 0}, 0.3, 0.2, 0.18, 1, {0, 0, 0});              // wrist
+    out.push_back(s);
+  }
+  {  // Biped: head on a neck, two arms with hands, two legs with feet (a human-body stand-in).
+    Shape s{"biped", {0.22, 0.14, 0.4}, {}, 0.06};
+    s.limbs.push_back({{0, 0, 0.42}, {0, 0, 0.55}, 0.06});   // neck
+    s.limbs.push_back({{0, 0, 0.62}, {0, 0.02, 0.72}, 0.1});  // head
+    for (int side = -1; side <= 1; side += 2) {
+      limb(s, {0.2 * side, 0, 0.3}, {side * 1.0, 0, -0.4}, 0.75, 0.055, 0.04, 3, {0, 0.3, -0.6});
+      limb(s, {0.1 * side, 0, -0.35}, {0.1 * side, 0, -1}, 0.85, 0.08, 0.055, 3, {0, 0.1, 0});
+      s.limbs.push_back({{0.13 * side, 0, -1.2}, {0.13 * side, 0.18, -1.22}, 0.05});  // foot
+    }
+    out.push_back(s);
+  }
+  {  // Spiky ball: a sphere with twelve short cones along the icosahedron's vertex directions.
+    Shape s{"spiky", {0.5, 0.5, 0.5}, {}, 0.04};
+    const double g = (1 + std::sqrt(5.0)) / 2;
+    const V3 dirs[12] = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                         {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+    for (const V3& d0 : dirs) {
+      V3 d = (1 / len(d0)) * d0;
+      limb(s, 0.4 * d, d, 0.45, 0.1, 0.02, 3, {0, 0, 0});
+    }
+    out.push_back(s);
+  }
+  {  // Disc: a flat wide body (large near-planar regions) with one thin handle.
+    Shape s{"disc", {0.8, 0.8, 0.08}, {}, 0.05};
+    limb(s, {0.75, 0, 0}, {1, 0, 0.3}, 0.7, 0.05, 0.035, 4, {0, 0.8, 0});
+    out.push_back(s);
+  }
   return out;
 }
 

@@ -54,7 +54,8 @@ struct OptimizerSettings {
   double regularizer_weight = 1e-4;
   /// Faces whose chord plane passes closer than this to the centre (large spherical
   /// triangles) are evaluated with Praun & Hoppe's accordion split; the final full-resolution
-  /// pass sets 0 and optimizes exactly the measured chord-triangle stretch. 0.99 splits
+  /// pass sets 0.25, so that only slivers along a great circle are split there and every other
+  /// face is measured on its chord triangle, as the efficiency is. 0.99 splits
   /// every face wider than about 8 degrees (circumradius), i.e. all faces of the coarse
   /// levels, where the layout of thin limbs is decided: there the bulge of a spherical
   /// triangle over its chord is large, and leaving it out (0.9: only faces above 26

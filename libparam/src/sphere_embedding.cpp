@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <array>
 
 #include "detail/parallel_jobs.h"
 #include "detail/worker_pool.h"
@@ -177,6 +178,7 @@ class Refiner {
     st_.face_weight = in_.face_weight.empty() ? std::vector<double>(static_cast<size_t>(nf), 1.0) : in_.face_weight;
     st_.face_shape_weight = in_.face_shape_weight;
     st_.fixed = in_.fixed;
+    pm_final_corners_ = st_.F;
     // Replay the collapses forward to recover the base level's corners.
     for (const auto& c : pm_.collapses) {
       for (int f : c.removed) st_.face_alive[static_cast<size_t>(f)] = 0;
@@ -282,7 +284,33 @@ class Refiner {
 
   Status optimize_level() { return optimize_level(s_); }
 
+  // Faces that close holes keep their low weight (and shape term) only while they lie in a
+  // hole: all three corners on a hole's rim or its centre. At coarse levels the progressive
+  // mesh can replace a rim corner by a vertex of the surface around it; such a face then
+  // spans real surface, and treated as nearly free (and, with the hole-area penalty, paid
+  // for taking sphere area from the real faces) it let coarse levels give whole regions' share
+  // of the sphere to it: generated shapes with many small holes on thin limbs ended with
+  // limbs squeezed, at an efficiency that changed with the seed by a factor of 1.7 (issue 20).
+  void update_hole_faces() {
+    if (in_.face_weight.empty()) return;
+    if (hole_vertex_.empty()) {
+      hole_vertex_.assign(st_.vertex_alive.size(), 0);
+      for (size_t f = 0; f < in_.face_weight.size(); ++f)
+        if (in_.face_weight[f] < 1.0)
+          for (int v : pm_final_corners_[f]) hole_vertex_[static_cast<size_t>(v)] = 1;
+    }
+    for (size_t f = 0; f < st_.F.size(); ++f) {
+      if (!(in_.face_weight[f] < 1.0) || !st_.face_alive[f]) continue;
+      bool inside = true;
+      for (int v : st_.F[f]) inside = inside && hole_vertex_[static_cast<size_t>(v)];
+      st_.face_weight[f] = inside ? in_.face_weight[f] : 1.0;
+      if (!st_.face_shape_weight.empty())
+        st_.face_shape_weight[f] = inside ? in_.face_shape_weight[f] : 0.0;
+    }
+  }
+
   Status optimize_level(const OptimizerSettings& s) {
+    update_hole_faces();
     st_.update_areas();
     for (int g = 0; g < s.global_iter; ++g) {
       std::uint64_t pass_key = s_.seed * 0xd1b54a32d192ed03ULL + static_cast<std::uint64_t>(stats_->passes) * 0x8cb92ba72f3d8dd7ULL;
@@ -303,6 +331,8 @@ class Refiner {
   EmbedStats* stats_;
   SphereState st_;
   RingScratch ring_;
+  std::vector<std::array<int, 3>> pm_final_corners_;  // every face's corners at full resolution
+  std::vector<char> hole_vertex_;                       // corners of the faces that close holes
   WorkerPool pool_;  // one set of threads for every pass of the run
 };
 

@@ -2,8 +2,9 @@
 // sets of constraints"). Above 32 features the constrained stage routes its path network
 // through a well-spread subset and carries the others onto their targets with the feature
 // warp (detail/feature_warp.h); these tests check that it gives complete, bijective maps with
-// every feature exactly on target, that the warp refuses what no flow can do, and that the
-// result does not depend on the thread count.
+// every feature exactly on target, that the warp refuses what no flow can do and names the
+// features it could not carry, that features whose arcs pass others are found and routed by
+// the network instead, and that the result does not depend on the thread count.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -49,6 +50,31 @@ std::vector<Eigen::Vector3d> twisted_targets(const RowMat3d& S, const std::vecto
 
 }  // namespace
 
+TEST_CASE("passing features: the feature whose arc runs by another is found, the others are not",
+          "[param][constrained][dense]") {
+  auto unit = [](double x, double y) { return Eigen::Vector3d(x, y, 1).normalized(); };
+  SECTION("an arc through a feature that stands still") {
+    // Feature 0 crosses over feature 1 (still); feature 2 moves parallel to 0, far from both.
+    const std::vector<Eigen::Vector3d> from{unit(-0.2, 0.001), unit(0, 0), unit(-0.2, 0.5)};
+    const std::vector<Eigen::Vector3d> to{unit(0.2, 0.001), unit(0, 0), unit(0.2, 0.5)};
+    CHECK(detail::passing_features(from, to) == std::vector<int>{0});
+  }
+  SECTION("two features trading places: the one that travels farther") {
+    const std::vector<Eigen::Vector3d> from{unit(-0.1, 0), unit(0.1, 0.01)};
+    const std::vector<Eigen::Vector3d> to{unit(0.12, 0), unit(-0.1, 0.01)};
+    CHECK(detail::passing_features(from, to) == std::vector<int>{0});
+  }
+  SECTION("the whole set turned about an axis: nobody passes") {
+    std::vector<Eigen::Vector3d> from, to;
+    const Eigen::AngleAxisd turn(0.7, Eigen::Vector3d(0.2, 0.3, 1).normalized());
+    for (int i = 0; i < 40; ++i) {
+      from.push_back(unit(0.05 * (i % 7) - 0.15, 0.05 * (i / 7) - 0.15));
+      to.push_back(turn * from.back());
+    }
+    CHECK(detail::passing_features(from, to).empty());
+  }
+}
+
 TEST_CASE("feature warp carries features onto their targets bijectively, or refuses and leaves the map",
           "[param][constrained][dense]") {
   const TriMesh m = test::icosphere(3);  // 642 vertices on the unit sphere: S = V is a bijection
@@ -76,9 +102,14 @@ TEST_CASE("feature warp carries features onto their targets bijectively, or refu
         if (angle(t[i], t[j]) < angle(t[a], t[b])) a = i, b = j;
     std::swap(t[a], t[b]);
     const RowMat3d before = S;
-    const Status s = detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &S);
+    detail::WarpStats st;
+    const Status s = detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &S, &st);
     CHECK(s.code() == ErrorCode::SolverFailed);
     CHECK(S == before);
+    // The caller learns which features to route through its network: one of the pair.
+    const bool named = std::find(st.culprits.begin(), st.culprits.end(), static_cast<int>(a)) != st.culprits.end() ||
+                       std::find(st.culprits.begin(), st.culprits.end(), static_cast<int>(b)) != st.culprits.end();
+    CHECK(named);
   }
 }
 
@@ -130,7 +161,55 @@ TEST_CASE("dense feature sets on a generated mesh: complete, bijective, exact, s
   CHECK(r2->map.S == r1->map.S);
 }
 
-TEST_CASE("shared faust5k: 64 dense landmarks, 2 members, give a complete consistent collection",
+TEST_CASE("dense feature set with a feature whose arc runs through a network feature: the network takes it in",
+          "[param][constrained][dense]") {
+  const TriMesh m = test::random_blob(4, 5);  // 2562 vertices
+  SphereParamOptions uo;
+  uo.effort = 0;
+  auto u = parameterize_sphere(m, uo);
+  REQUIRE(u.ok());
+  const int k = 128;
+  const auto sets = test::farthest_point_landmarks(m, {}, k);
+  const std::vector<int>& fv = sets[0];
+  REQUIRE(static_cast<int>(fv.size()) == k);
+  // Every feature stays where the unconstrained map puts it, except the one nearest feature 0
+  // (always in the network: spread_subset starts there), which turns half-way round it: its
+  // great arc runs through feature 0, so no flow of the sphere carries it there while
+  // feature 0 stands still; it has to pass on one side, as a path of the network does.
+  std::vector<Eigen::Vector3d> t;
+  for (int v : fv) t.push_back(u->map.S.row(v).transpose());
+  const Eigen::Vector3d c = t[0];
+  int j = 1;
+  for (int i = 2; i < k; ++i)
+    if (angle(t[static_cast<size_t>(i)], c) < angle(t[static_cast<size_t>(j)], c)) j = i;
+  t[static_cast<size_t>(j)] = Eigen::AngleAxisd(M_PI, c) * t[static_cast<size_t>(j)];
+  for (int i = 0; i < k; ++i)
+    if (i != j) REQUIRE(angle(t[static_cast<size_t>(i)], t[static_cast<size_t>(j)]) > 0.05);  // targets stay distinct
+  ConstrainedParamOptions o;
+  o.sphere.effort = 0;
+  o.sphere.threads = 1;
+  auto r1 = parameterize_sphere_constrained(m, fv, t, o);
+  REQUIRE(r1.ok());
+  CHECK(r1->flipped_faces == 0);
+  CHECK(r1->max_feature_angle < 1e-9);
+  CHECK(std::abs(r1->winding - 1) < 1e-9);
+  test::require_valid_map(m, r1->map.S);
+  // Completed by the warp from a grown network, not by the network over all features: the
+  // first network left the feature on the far side, so it took more than one attempt, and
+  // the final network is larger than the first but far from all 128 features.
+  CHECK(r1->network.attempts > 1);
+  CHECK(r1->network.warped_features > 0);
+  const int networked = k - r1->network.warped_features;
+  CHECK(networked > detail::kDenseNetworkSizes[0]);
+  CHECK(networked < k / 2);
+  CHECK(r1->network.paths == 3 * networked - 6);
+  o.sphere.threads = 2;
+  auto r2 = parameterize_sphere_constrained(m, fv, t, o);
+  REQUIRE(r2.ok());
+  CHECK(r2->map.S == r1->map.S);
+}
+
+TEST_CASE("shared faust5k: 64 and 128 dense landmarks, 2 members, give a complete consistent collection",
           "[param][consistent][dense][shared][slow]") {
   SPHEREKIT_REQUIRE_SHARED_MESHES(meshes);
   const std::string fam = meshes + "/families/faust5k/";
@@ -139,8 +218,10 @@ TEST_CASE("shared faust5k: 64 dense landmarks, 2 members, give a complete consis
   const auto ca = test::read_int_list(fam + "tr_reg_000.corr.txt"), cb = test::read_int_list(fam + "tr_reg_013.corr.txt");
   REQUIRE(!ca.empty());
   REQUIRE(ca.size() == cb.size());
-  const auto sets = test::farthest_point_landmarks(a, {test::carry_through_samples(ca, cb)}, 64);
-  REQUIRE(sets[0].size() == 64);
+  const int k = GENERATE(64, 128);
+  CAPTURE(k);
+  const auto sets = test::farthest_point_landmarks(a, {test::carry_through_samples(ca, cb)}, k);
+  REQUIRE(static_cast<int>(sets[0].size()) == k);
   INFO("fewest edges between two landmarks: " << test::min_hops_between(a, sets[0]) << " on 000, "
                                               << test::min_hops_between(b, sets[1]) << " on 013");
   ConsistentParamOptions o;
@@ -155,6 +236,9 @@ TEST_CASE("shared faust5k: 64 dense landmarks, 2 members, give a complete consis
     CHECK(m.flipped_faces == 0);
     CHECK(m.max_feature_angle < 1e-9);
     CHECK(std::abs(m.winding - 1) < 1e-9);
+    // Completed by a subset network and the warp, not by the network over all features
+    // (which took minutes here before the subset grew by the features the warp could not carry).
+    CHECK(m.network.warped_features > 0);
     test::require_valid_map(i == 0 ? a : b, m.map.S);
   }
 }

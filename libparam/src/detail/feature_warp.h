@@ -7,6 +7,14 @@
 // network variant fails). So the network triangulates a well-spread subset of the features
 // (the sparse case, which works), and the other features are then carried onto their targets
 // by a smooth flow of the sphere, checked with the exact predicate at every step.
+//
+// Why the subset grows: the network constrains only its subset, so the stretch-optimal map
+// leaves the other features where stretch puts them, in places on the far side of a network
+// feature or of another feature (faust5k 013 with 64 landmarks: a feature 0.24 rad from its
+// target whose great arc runs within 0.002 rad of a network feature; the flow then has to
+// squeeze the mesh between them below its resolution and stalls). When the flow fails, the
+// features that pass others (passing_features) and those nearest the faces that kept flipping
+// (WarpStats::culprits) join the network, which routes them by paths, on the right side.
 #pragma once
 
 #include <vector>
@@ -21,18 +29,32 @@ namespace spherekit::detail {
 
 /// Above this many features the constrained stage routes its path network through a subset.
 constexpr int kDenseFeatureThreshold = 32;
-/// Size of that subset: the first that works of these.
-constexpr int kDenseNetworkSizes[] = {24, 16, 32};
+/// Size of that subset to start from: the first that works of these (a size whose network's
+/// Steiner vertices cannot be removed gives way to the next, which routes other paths).
+constexpr int kDenseNetworkSizes[] = {24, 16, 20, 32};
 constexpr int kDenseNetworkFeatures = kDenseNetworkSizes[0];
+/// Attempts per starting size, each adding to the network the features the previous warp
+/// could not carry (measured on faust5k 000 + 013: at most 3 were needed with 64 and 128
+/// landmarks; each costs one network and one stretch optimization).
+constexpr int kDenseGrowRounds = 6;
 
 /// `count` indices of well-spread targets: farthest-point samples on the sphere (angles),
 /// starting with target 0, ties to the lower index. Sorted ascending.
 std::vector<int> spread_subset(const std::vector<Eigen::Vector3d>& targets, int count);
 
+/// Two features "pass" each other when, moving along their great arcs at proportional speeds,
+/// they come closer than this fraction of their distance at both ends.
+constexpr double kPassingRatio = 0.5;
+
+/// Indices of features whose arcs from `from` to `to` pass another feature (the one of each
+/// such pair that travels farther; a feature with from == to stands still). Sorted.
+std::vector<int> passing_features(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to);
+
 struct WarpStats {
   int steps = 0;     ///< accepted flow steps
   int rejected = 0;  ///< steps halved because a face flipped
   int reshaped = 0;  ///< slivers reshaped (untangle_patch) because they flipped at any step
+  std::vector<int> culprits;  ///< on failure: indices of the features nearest the faces that kept flipping
 };
 
 /// Moves the map S (a bijection of the mesh with faces F onto the sphere: 0 flipped faces)
@@ -41,7 +63,9 @@ struct WarpStats {
 /// vertices by the compactly supported radial-basis interpolant of the features' displacements (features
 /// already on target do not move). A step that flips a face (exact predicate) is halved.
 /// A face that flips however small the step (a sliver wider than the field's support) is
-/// reshaped with untangle_patch against its shape in the mesh X, features fixed.
+/// reshaped with untangle_patch against its shape in the mesh X, features fixed (at most
+/// 100 times; then the warp gives up and names in stats->culprits the two
+/// moving features nearest each face that still flips).
 /// On success S has 0 flipped faces and every feature exactly on its target; otherwise
 /// SolverFailed and S unchanged. Deterministic (one thread).
 Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std::vector<int>& fv,

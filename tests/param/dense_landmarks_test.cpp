@@ -161,7 +161,7 @@ TEST_CASE("dense feature sets on a generated mesh: complete, bijective, exact, s
   CHECK(r2->map.S == r1->map.S);
 }
 
-TEST_CASE("dense feature set with a feature whose arc runs through a network feature: the network takes it in",
+TEST_CASE("dense feature set with a feature turned half-way round a network feature: carried by the warp, bijective, exact",
           "[param][constrained][dense]") {
   const TriMesh m = test::random_blob(4, 5);  // 2562 vertices
   SphereParamOptions uo;
@@ -194,13 +194,13 @@ TEST_CASE("dense feature set with a feature whose arc runs through a network fea
   CHECK(r1->max_feature_angle < 1e-9);
   CHECK(std::abs(r1->winding - 1) < 1e-9);
   test::require_valid_map(m, r1->map.S);
-  // Completed by the warp from a grown network, not by the network over all features: the
-  // first network left the feature on the far side, so it took more than one attempt, and
-  // the final network is larger than the first but far from all 128 features.
-  CHECK(r1->network.attempts > 1);
+  // Completed by the warp, not by the network over all features. Where the first network
+  // left the feature on the far side (it did before the stretch energy's anti-cruft term
+  // changed, issue 20; now the flow carries it round feature 0 at the first attempt), the
+  // final network is larger than the first; in either case far from all 128 features.
   CHECK(r1->network.warped_features > 0);
   const int networked = k - r1->network.warped_features;
-  CHECK(networked > detail::kDenseNetworkSizes[0]);
+  if (r1->network.attempts > 1) CHECK(networked > detail::kDenseNetworkSizes[0]);
   CHECK(networked < k / 2);
   CHECK(r1->network.paths == 3 * networked - 6);
   o.sphere.threads = 2;

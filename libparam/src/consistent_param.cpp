@@ -304,7 +304,8 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
     const ProgressFn p5 = prefixed(progress, "step 5");
     ProgressiveMeshOptions pmo;
     SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, grid_faces, pmo, p5));
-    const detail::OptimizerSettings settings = detail::optimizer_settings(sphere);
+    detail::OptimizerSettings settings = detail::optimizer_settings(sphere);
+    settings.edge_frame_cruft = false;  // the collection stages' energy (stretch_optimizer.cpp, singular_cruft_term)
     detail::EmbedInput in;
     in.P = &P;
     in.pm = &pm;

@@ -496,7 +496,8 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
 
   // 6. Coarse-to-fine refinement with the features fixed on their targets.
   t0 = std::chrono::steady_clock::now();
-  const detail::OptimizerSettings settings = detail::optimizer_settings(so);
+  detail::OptimizerSettings settings = detail::optimizer_settings(so);
+  settings.edge_frame_cruft = false;  // the collection stages' energy (stretch_optimizer.cpp, singular_cruft_term)
   std::vector<double> wnet(static_cast<size_t>(nnf), 1.0), snet(static_cast<size_t>(nnf), 0.0);
   for (int f = 0; f < nnf; ++f)
     if (net.face_origin[static_cast<size_t>(f)] >= filled.original_faces) {

@@ -167,6 +167,7 @@ class Refiner {
   }
 
   void init_base_level() {
+    st_.edge_frame_cruft = s_.edge_frame_cruft;  // also for the splits' local moves
     const int nv = pm_.num_vertices;
     const int nf = static_cast<int>(pm_.F.rows());
     st_.P = in_.P;
@@ -310,6 +311,7 @@ class Refiner {
   }
 
   Status optimize_level(const OptimizerSettings& s) {
+    st_.edge_frame_cruft = s.edge_frame_cruft;
     update_hole_faces();
     st_.update_areas();
     for (int g = 0; g < s.global_iter; ++g) {

@@ -34,6 +34,9 @@ struct SphereState {
   std::vector<double> model_scale;    ///< per model: 4 pi / model_area (surface rescaled to the sphere's area)
 
   double hole_area_penalty = 0;       ///< lambda per unit chord area of real faces (meshes with holes)
+  /// Anti-cruft term: mean over the three edge frames (true) or w * g^-3 with g the smallest
+  /// squared singular value (false); see stretch_optimizer.cpp.
+  bool edge_frame_cruft = true;
 
   /// Recomputes model_area (and the derived scales and the hole-area penalty) over the alive faces.
   void update_areas();
@@ -67,6 +70,7 @@ struct OptimizerSettings {
   int threads = 0;             ///< 0 = hardware concurrency
   int max_rounds = 2000;       ///< safety cap on rounds per pass
   bool coloured_rounds = false;  ///< rounds as colour classes (every computed move applied) instead of one greedy independent set
+  bool edge_frame_cruft = true;  ///< SphereState::edge_frame_cruft for this stage (the collection stages set false)
 };
 
 OptimizerSettings settings_for_effort(int effort);

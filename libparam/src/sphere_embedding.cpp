@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
-#include <array>
 
 #include "detail/parallel_jobs.h"
 #include "detail/worker_pool.h"
@@ -167,7 +166,7 @@ class Refiner {
   }
 
   void init_base_level() {
-    st_.edge_frame_cruft = s_.edge_frame_cruft;  // also for the splits' local moves
+    st_.edge_frame_cruft = s_.edge_frame_cruft;  // every level and the splits' local moves
     const int nv = pm_.num_vertices;
     const int nf = static_cast<int>(pm_.F.rows());
     st_.P = in_.P;
@@ -179,7 +178,11 @@ class Refiner {
     st_.face_weight = in_.face_weight.empty() ? std::vector<double>(static_cast<size_t>(nf), 1.0) : in_.face_weight;
     st_.face_shape_weight = in_.face_shape_weight;
     st_.fixed = in_.fixed;
-    pm_final_corners_ = st_.F;
+    // The corners of the faces that close holes, at full resolution (update_hole_faces).
+    hole_vertex_.assign(static_cast<size_t>(nv), 0);
+    for (size_t f = 0; f < in_.face_weight.size(); ++f)
+      if (in_.face_weight[f] < 1.0)
+        for (int v : st_.F[f]) hole_vertex_[static_cast<size_t>(v)] = 1;
     // Replay the collapses forward to recover the base level's corners.
     for (const auto& c : pm_.collapses) {
       for (int f : c.removed) st_.face_alive[static_cast<size_t>(f)] = 0;
@@ -294,12 +297,6 @@ class Refiner {
   // limbs squeezed, at an efficiency that changed with the seed by a factor of 1.7 (issue 20).
   void update_hole_faces() {
     if (in_.face_weight.empty()) return;
-    if (hole_vertex_.empty()) {
-      hole_vertex_.assign(st_.vertex_alive.size(), 0);
-      for (size_t f = 0; f < in_.face_weight.size(); ++f)
-        if (in_.face_weight[f] < 1.0)
-          for (int v : pm_final_corners_[f]) hole_vertex_[static_cast<size_t>(v)] = 1;
-    }
     for (size_t f = 0; f < st_.F.size(); ++f) {
       if (!(in_.face_weight[f] < 1.0) || !st_.face_alive[f]) continue;
       bool inside = true;
@@ -311,7 +308,6 @@ class Refiner {
   }
 
   Status optimize_level(const OptimizerSettings& s) {
-    st_.edge_frame_cruft = s.edge_frame_cruft;
     update_hole_faces();
     st_.update_areas();
     for (int g = 0; g < s.global_iter; ++g) {
@@ -333,8 +329,7 @@ class Refiner {
   EmbedStats* stats_;
   SphereState st_;
   RingScratch ring_;
-  std::vector<std::array<int, 3>> pm_final_corners_;  // every face's corners at full resolution
-  std::vector<char> hole_vertex_;                       // corners of the faces that close holes
+  std::vector<char> hole_vertex_;  // corners of the faces that close holes, at full resolution
   WorkerPool pool_;  // one set of threads for every pass of the run
 };
 

@@ -132,6 +132,19 @@ TEST_CASE("spread subset: well-spread, deterministic, sorted", "[param][constrai
 
 namespace {
 
+// k farthest-point landmarks of m, and m's unconstrained map at effort 0 in *S (where the
+// targets are made from).
+std::vector<int> unconstrained_map_and_landmarks(const TriMesh& m, int k, RowMat3d* S) {
+  SphereParamOptions uo;
+  uo.effort = 0;
+  auto u = parameterize_sphere(m, uo);
+  REQUIRE(u.ok());
+  *S = u->map.S;
+  const auto sets = test::farthest_point_landmarks(m, {}, k);
+  REQUIRE(static_cast<int>(sets[0].size()) == k);
+  return sets[0];
+}
+
 // The constrained map of m with features fv on targets t at effort 0: bijective, features
 // exact, winding 1, and the same bits with 1 and 2 threads. Returns the 1-thread result.
 ConstrainedParamResult require_exact_deterministic_map(const TriMesh& m, const std::vector<int>& fv,
@@ -157,16 +170,11 @@ ConstrainedParamResult require_exact_deterministic_map(const TriMesh& m, const s
 TEST_CASE("dense feature sets on a generated mesh: complete, bijective, exact, same bits for any thread count",
           "[param][constrained][dense]") {
   const TriMesh m = test::random_blob(4, 7);  // 2562 vertices
-  SphereParamOptions uo;
-  uo.effort = 0;
-  auto u = parameterize_sphere(m, uo);
-  REQUIRE(u.ok());
   const int k = GENERATE(48, 96);
   CAPTURE(k);
-  const auto sets = test::farthest_point_landmarks(m, {}, k);
-  const std::vector<int>& fv = sets[0];
-  REQUIRE(static_cast<int>(fv.size()) == k);
-  const auto t = twisted_targets(u->map.S, fv, 0.2);
+  RowMat3d S0;
+  const std::vector<int> fv = unconstrained_map_and_landmarks(m, k, &S0);
+  const auto t = twisted_targets(S0, fv, 0.2);
   const ConstrainedParamResult r1 = require_exact_deterministic_map(m, fv, t);
   // The network triangulates a subset (3 m - 6 paths for m features), the warp the rest.
   CHECK(r1.network.warped_features > 0);
@@ -176,20 +184,15 @@ TEST_CASE("dense feature sets on a generated mesh: complete, bijective, exact, s
 TEST_CASE("dense feature set with a feature turned half-way round a network feature: carried by the warp, bijective, exact",
           "[param][constrained][dense]") {
   const TriMesh m = test::random_blob(4, 5);  // 2562 vertices
-  SphereParamOptions uo;
-  uo.effort = 0;
-  auto u = parameterize_sphere(m, uo);
-  REQUIRE(u.ok());
   const int k = 128;
-  const auto sets = test::farthest_point_landmarks(m, {}, k);
-  const std::vector<int>& fv = sets[0];
-  REQUIRE(static_cast<int>(fv.size()) == k);
+  RowMat3d S0;
+  const std::vector<int> fv = unconstrained_map_and_landmarks(m, k, &S0);
   // Every feature stays where the unconstrained map puts it, except the one nearest feature 0
   // (always in the network: spread_subset starts there), which turns half-way round it: its
   // great arc runs through feature 0, so no flow of the sphere carries it there while
   // feature 0 stands still; it has to pass on one side, as a path of the network does.
   std::vector<Eigen::Vector3d> t;
-  for (int v : fv) t.push_back(u->map.S.row(v).transpose());
+  for (int v : fv) t.push_back(S0.row(v).transpose());
   const Eigen::Vector3d c = t[0];
   int j = 1;
   for (int i = 2; i < k; ++i)

@@ -186,6 +186,41 @@ std::vector<int> snap_texels(const std::vector<Eigen::Vector3d>& locations, int 
   return texel;
 }
 
+// The correspondence refinement after the last step (refine_correspondence.h), the measures
+// of every refined map recomputed.
+Status refine_maps(const std::vector<TriMesh>& meshes, const std::vector<std::vector<int>>& features,
+                   const ConsistentParamOptions& options, const ProgressFn& progress, ConsistentParamResult* result) {
+  const int n = static_cast<int>(meshes.size());
+  if (!options.refine_correspondence || n < 2) return Status();
+  const auto t0 = std::chrono::steady_clock::now();
+  RefineCorrespondenceOptions ro = options.refinement;
+  ro.template_mesh = options.reference;
+  ro.threads = options.threads;
+  std::vector<RowMat3d> S(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) S[static_cast<size_t>(i)] = result->maps[static_cast<size_t>(i)].map.S;
+  SPHEREKIT_ASSIGN_OR_RETURN(result->refinement, refine_correspondence(meshes, features, S, ro, progress));
+  for (int i = 0; i < n; ++i) {
+    if (!result->refinement.members[static_cast<size_t>(i)].refined) continue;
+    ConstrainedParamResult& m = result->maps[static_cast<size_t>(i)];
+    SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics mm,
+                               evaluate_sphere_map(meshes[static_cast<size_t>(i)], S[static_cast<size_t>(i)]));
+    m.map.S = std::move(S[static_cast<size_t>(i)]);
+    m.flipped_faces = count_flipped_faces(meshes[static_cast<size_t>(i)].F, m.map.S);
+    m.efficiency = mm.efficiency;
+    m.l2_stretch = mm.l2_stretch;
+    m.linf_stretch = mm.linf;
+    m.winding = mm.winding;
+    m.max_feature_angle = 0;
+    for (size_t f = 0; f < features[static_cast<size_t>(i)].size(); ++f) {
+      const Eigen::Vector3d s = m.map.S.row(features[static_cast<size_t>(i)][f]).transpose();
+      const Eigen::Vector3d& F = result->final_locations[f];
+      m.max_feature_angle = std::max(m.max_feature_angle, std::atan2(s.cross(F).norm(), s.dot(F)));
+    }
+  }
+  result->times.refinement = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return Status();
+}
+
 }  // namespace
 
 Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>& meshes,
@@ -261,6 +296,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   result.final_locations = result.initial_locations;
   if (!options.refine_locations || n < 2) {
     // One mesh: the joint map of step 5 would be its own unconstrained map again.
+    SPHEREKIT_RETURN_IF_ERROR(refine_maps(meshes, features, options, progress, &result));
     result.times.total = seconds_since(t_start);
     return result;
   }
@@ -359,6 +395,8 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
     return s6;
   }
   result.times.final_maps = seconds_since(t0);
+
+  SPHEREKIT_RETURN_IF_ERROR(refine_maps(meshes, features, options, progress, &result));
   result.times.total = seconds_since(t_start);
   return result;
 }

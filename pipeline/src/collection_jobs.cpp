@@ -164,6 +164,21 @@ Result<Json> verify_registered_map(const std::string& map_path, const TriMesh& m
   return j;
 }
 
+// What the correspondence refinement did to one member (refine_correspondence.h); no time,
+// so that the manifest's bytes do not depend on the machine.
+Json refinement_json(const RefinedMember& m) {
+  Json j{{"refined", m.refined}};
+  if (!m.note.empty()) j["note"] = m.note;
+  if (m.note == "template") return j;
+  j["rounds"] = m.rounds;
+  j["samples"] = m.samples;
+  j["energy_before"] = m.energy_before;
+  j["energy_after"] = m.energy_after;
+  j["efficiency_before"] = m.efficiency_before;
+  j["efficiency_after"] = m.efficiency_after;
+  return j;
+}
+
 formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const ConsistentParamOptions& o,
                                         const std::string& refinement_failure) {
   const ConsistentParamResult& r = out.maps;
@@ -185,11 +200,18 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
     e.feature_vertices = std::vector<long long>(m.feature_vertices.begin(), m.feature_vertices.end());
     e.added = false;
     e.result = map_entry_json(r.maps[i]);
+    if (i < r.refinement.members.size()) e.result["correspondence_refinement"] = refinement_json(r.refinement.members[i]);
     man.members.push_back(std::move(e));
   }
   man.options = constrained_options_json(o.constrained);
   man.options["remesh_size"] = o.remesh_size;
   man.options["refine_locations"] = o.refine_locations;
+  man.options["refine_correspondence"] = o.refine_correspondence;
+  if (o.refine_correspondence)
+    man.options["refinement"] = Json{{"iterations", o.refinement.iterations},
+                                     {"damping", o.refinement.damping},
+                                     {"rounds", o.refinement.rounds},
+                                     {"samples", o.refinement.samples}};
   if (!refinement_failure.empty()) {
     man.method = "consistent (steps 1-2: reference locations; step 6 failed)";
     man.extra["refinement_failure"] = refinement_failure;
@@ -227,7 +249,7 @@ Json consistent_times_json(const MakeCollectionResult& out) {
   Json t{{"step1_reference", r.times.reference}, {"step2_initial_maps", r.times.initial},
          {"step3_remesh", r.times.remesh},       {"step4_concatenate", r.times.concatenate},
          {"step5_joint_map", r.times.joint},     {"step6_final_maps", r.times.final_maps},
-         {"total", r.times.total}};
+         {"refine_correspondence", r.times.refinement}, {"total", r.times.total}};
   for (size_t i = 0; i < out.members.size() && i < r.maps.size(); ++i) t["members"][out.members[i].name] = map_times_json(r.maps[i]);
   return t;
 }

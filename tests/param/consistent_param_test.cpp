@@ -168,6 +168,42 @@ TEST_CASE("consistent maps without refinement keep the reference's own map", "[p
   }
 }
 
+TEST_CASE("the correspondence refinement brings the members closer to the reference's correspondence",
+          "[param][consistent][refine]") {
+  const auto& c = small_collection();
+  std::vector<TriMesh> meshes;
+  std::vector<std::vector<int>> features;
+  split(c, &meshes, &features);
+  ConsistentParamOptions o = fast_options();
+  o.refine_locations = false;  // steps 1-2: the refinement works on any consistent maps
+  o.refine_correspondence = false;
+  auto plain = parameterize_consistent(meshes, features, o);
+  o.refine_correspondence = true;
+  auto refined = parameterize_consistent(meshes, features, o);
+  REQUIRE(plain.ok());
+  REQUIRE(refined.ok());
+  REQUIRE(refined->refinement.members.size() == c.size());
+  CHECK(plain->refinement.members.empty());
+  CHECK(refined->maps[0].map.S == plain->maps[0].map.S);  // the reference is the template
+  int taken = 0;
+  for (size_t i = 1; i < c.size(); ++i) {
+    const RefinedMember& m = refined->refinement.members[i];
+    INFO(c[i].name << ": " << m.note);
+    test::require_valid_map(c[i].mesh, refined->maps[i].map.S);
+    for (size_t k = 0; k < features[i].size(); ++k)
+      CHECK(refined->maps[i].map.S.row(features[i][k]) == plain->maps[i].map.S.row(features[i][k]));
+    CHECK(refined->maps[i].efficiency == Approx(m.efficiency_after).epsilon(1e-12));
+    CHECK(m.efficiency_after >= 0.8 * std::min(m.efficiency_before, plain->maps[0].efficiency));
+    if (!m.refined) continue;
+    ++taken;
+    const double before = mean_transfer_error(c[0], plain->maps[0].map.S, c[i], plain->maps[i].map.S);
+    const double after = mean_transfer_error(c[0], refined->maps[0].map.S, c[i], refined->maps[i].map.S);
+    INFO("error " << before << " -> " << after);
+    CHECK(after < before);
+  }
+  CHECK(taken >= 1);
+}
+
 TEST_CASE("consistent maps are the same bits for any thread count", "[param][consistent]") {
   const auto& c = small_collection();
   std::vector<TriMesh> meshes;

@@ -113,6 +113,8 @@ void register_consistent(CLI::App& app) {
   cmd->add_flag("!--no-refine-locations", args->job.options.refine_locations,
                 "stop after step 2 (locations from the reference alone)");
   cmd->add_flag("!--no-refine", args->job.options.refine_locations)->group("");  // the earlier spelling
+  cmd->add_flag("!--no-refine-correspondence", args->job.options.refine_correspondence,
+                "keep the step-6 maps (no correspondence refinement against the reference)");
   cmd->add_option("--report", args->report, "also write a JSON report here");
   cmd->add_flag("-q,--quiet", args->quiet, "print neither progress nor the summary (errors still)");
   add_sphere_param_options(*cmd, args->sphere);

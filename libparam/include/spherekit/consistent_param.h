@@ -22,6 +22,7 @@
 #include "spherekit/constrained_param.h"
 #include "spherekit/mesh.h"
 #include "spherekit/progress.h"
+#include "spherekit/refine_correspondence.h"
 #include "spherekit/status.h"
 
 namespace spherekit {
@@ -39,6 +40,11 @@ struct ConsistentParamOptions {
   /// false: stop after step 2 (every mesh constrained to the reference's feature images; the
   /// reference keeps its unconstrained map). For comparisons and quick previews.
   bool refine_locations = true;
+  /// After step 6, refine the correspondence (refine_correspondence.h): every other mesh's
+  /// map is fitted to the reference's, so that the maps agree between the features too, not
+  /// only at them. Its template is `reference`; its threads are `threads`. Shape-defining.
+  bool refine_correspondence = true;
+  RefineCorrespondenceOptions refinement;
   /// Worker threads in total (0 = hardware). Steps 2 and 6 map several meshes at once.
   /// Effort only: the result is the same for any value.
   int threads = 0;
@@ -52,6 +58,7 @@ struct ConsistentParamTimes {
   double concatenate = 0;    ///< step 4
   double joint = 0;          ///< step 5
   double final_maps = 0;     ///< step 6
+  double refinement = 0;     ///< correspondence refinement (after step 6)
   double total = 0;
 };
 
@@ -75,6 +82,8 @@ struct ConsistentParamResult {
   int refinement_failure_mesh = -1;
   std::string refinement_failure_reason;
   std::vector<Eigen::Vector3d> rejected_locations;
+  /// The correspondence refinement, when it ran (members empty otherwise).
+  RefineCorrespondenceResult refinement;
   ConsistentParamTimes times;
 };
 

@@ -1,0 +1,633 @@
+// Correspondence refinement (see refine_correspondence.h): the template carried onto each
+// member as rigidly as possible, through a bijection of the sphere.
+#include "spherekit/refine_correspondence.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <utility>
+
+#include <Eigen/SVD>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include "detail/feature_warp.h"
+#include "detail/parallel_jobs.h"
+#include "detail/sphere_locator.h"
+#include "spherekit/correspondence.h"
+#include "spherekit/geometry_image.h"
+#include "spherekit/metrics.h"
+#include "spherekit/predicates.h"
+
+namespace spherekit {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+bool has_boundary(const RowMat3i& F) {
+  std::map<std::pair<int, int>, int> count;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = F(f, c), b = F(f, (c + 1) % 3);
+      ++count[{std::min(a, b), std::max(a, b)}];
+    }
+  for (const auto& [edge, n] : count)
+    if (n != 2) return true;
+  return false;
+}
+
+// The template's rigidity metric: symmetric spoke weights (cotangent, clamped to a small
+// positive floor so that the system stays positive definite on poor triangulations), the
+// spokes as CSR, and lumped vertex areas.
+struct TemplateMetric {
+  std::vector<int> start;   // CSR over vertices
+  std::vector<int> nbr;
+  std::vector<double> w;
+  std::vector<double> area;  // a third of the incident faces' areas
+  double total_area = 0;
+  double mean_diag = 0;      // mean of the Laplacian's diagonal
+  double mean_area = 0;
+};
+
+TemplateMetric template_metric(const TriMesh& m) {
+  const int nv = static_cast<int>(m.V.rows());
+  std::map<std::pair<int, int>, double> cot;
+  TemplateMetric t;
+  t.area.assign(static_cast<size_t>(nv), 0.0);
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const Vec3 p[3] = {m.V.row(m.F(f, 0)).transpose(), m.V.row(m.F(f, 1)).transpose(),
+                       m.V.row(m.F(f, 2)).transpose()};
+    const double a2 = (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    t.total_area += 0.5 * a2;
+    for (int c = 0; c < 3; ++c) {
+      t.area[static_cast<size_t>(m.F(f, c))] += a2 / 6.0;
+      // The angle at corner c is opposite edge (c+1, c+2).
+      const Vec3 u = p[(c + 1) % 3] - p[c], v = p[(c + 2) % 3] - p[c];
+      const double s = u.cross(v).norm();
+      const double ct = s > 0 ? u.dot(v) / s : 0.0;
+      const int a = m.F(f, (c + 1) % 3), b = m.F(f, (c + 2) % 3);
+      cot[{std::min(a, b), std::max(a, b)}] += 0.5 * ct;
+    }
+  }
+  double mean_w = 0;
+  for (const auto& [e, c] : cot) mean_w += std::abs(c);
+  mean_w = cot.empty() ? 1.0 : mean_w / static_cast<double>(cot.size());
+  const double floor = 1e-2 * mean_w;
+  std::vector<std::vector<std::pair<int, double>>> adj(static_cast<size_t>(nv));
+  for (const auto& [e, c] : cot) {
+    const double wt = std::max(c, floor);
+    adj[static_cast<size_t>(e.first)].push_back({e.second, wt});
+    adj[static_cast<size_t>(e.second)].push_back({e.first, wt});
+  }
+  t.start.push_back(0);
+  double diag = 0;
+  for (int v = 0; v < nv; ++v) {
+    std::sort(adj[static_cast<size_t>(v)].begin(), adj[static_cast<size_t>(v)].end());
+    for (const auto& [j, wt] : adj[static_cast<size_t>(v)]) {
+      t.nbr.push_back(j);
+      t.w.push_back(wt);
+      diag += wt;
+    }
+    t.start.push_back(static_cast<int>(t.nbr.size()));
+  }
+  t.mean_diag = nv > 0 ? diag / nv : 1.0;
+  t.mean_area = nv > 0 ? t.total_area / nv : 1.0;
+  return t;
+}
+
+// Faces around each vertex of a mesh (CSR).
+struct VertexFaces {
+  std::vector<int> start, face;
+  explicit VertexFaces(const TriMesh& m) {
+    const int nv = static_cast<int>(m.V.rows());
+    start.assign(static_cast<size_t>(nv) + 1, 0);
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) ++start[static_cast<size_t>(m.F(f, c)) + 1];
+    for (int v = 0; v < nv; ++v) start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
+    face.resize(static_cast<size_t>(start.back()));
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) face[static_cast<size_t>(fill[static_cast<size_t>(m.F(f, c))]++)] = static_cast<int>(f);
+  }
+};
+
+// Walks on the surface from `p` to a point locally nearest to `target`: moves to the
+// nearest point of the faces around the current face's corners while that is nearer.
+SurfacePoint walk_to_nearest(const TriMesh& m, const VertexFaces& vf, SurfacePoint p, const Vec3& target) {
+  auto closest = [&](int f, Vec3& bary) {
+    return detail::closest_point_on_triangle(target, m.V.row(m.F(f, 0)).transpose(), m.V.row(m.F(f, 1)).transpose(),
+                                             m.V.row(m.F(f, 2)).transpose(), bary);
+  };
+  Vec3 bary;
+  double best = (closest(p.face, bary) - target).squaredNorm();
+  p.bary = bary;
+  for (int step = 0; step < 256; ++step) {
+    int best_face = -1;
+    Vec3 best_bary;
+    for (int c = 0; c < 3; ++c) {
+      const int v = m.F(p.face, c);
+      for (int k = vf.start[static_cast<size_t>(v)]; k < vf.start[static_cast<size_t>(v) + 1]; ++k) {
+        const int g = vf.face[static_cast<size_t>(k)];
+        if (g == p.face) continue;
+        const double d = (closest(g, bary) - target).squaredNorm();
+        if (d < best * (1 - 1e-12) - 1e-300) best = d, best_face = g, best_bary = bary;
+      }
+    }
+    if (best_face < 0) break;
+    p.face = best_face;
+    p.bary = best_bary;
+  }
+  return p;
+}
+
+Vec3 sphere_point(const TriMesh& m, const RowMat3d& S, const SurfacePoint& p) {
+  Vec3 s = Vec3::Zero();
+  for (int c = 0; c < 3; ++c) s += p.bary[c] * S.row(m.F(p.face, c)).transpose();
+  const double n = s.norm();
+  return n > 0 ? Vec3(s / n) : Vec3(S.row(m.F(p.face, 0)).transpose());
+}
+
+// One member fitted to the template.
+class MemberFit {
+ public:
+  MemberFit(const TriMesh& tmpl, const RowMat3d& St, const TemplateMetric& metric, const std::vector<int>& tfeat,
+            const TriMesh& mesh, const RowMat3d& Si, const std::vector<int>& feat, const RefineCorrespondenceOptions& o)
+      : t_(tmpl), St_(St), metric_(metric), m_(mesh), Si_(Si), vf_(mesh), o_(o) {
+    const int nv = static_cast<int>(t_.V.rows());
+    q_.resize(static_cast<size_t>(nv));
+    sp_.resize(static_cast<size_t>(nv));
+    Y_.resize(nv, 3);
+    fixed_.assign(static_cast<size_t>(nv), 0);
+    const SphereLocator locator(m_.F, Si_);
+    for (int v = 0; v < nv; ++v) {
+      q_[static_cast<size_t>(v)] = St_.row(v).transpose();
+      const SphereLocation loc = locator.locate(q_[static_cast<size_t>(v)]);
+      sp_[static_cast<size_t>(v)] = SurfacePoint{loc.face, loc.bary};
+      if (!loc.inside) fixed_[static_cast<size_t>(v)] = 1;  // in a hole of the member: no surface to move on
+    }
+    for (size_t k = 0; k < tfeat.size(); ++k) {
+      const int v = tfeat[k];
+      sp_[static_cast<size_t>(v)] = vertex_surface_point(m_, feat[k]);
+      fixed_[static_cast<size_t>(v)] = 1;
+    }
+    for (int v = 0; v < nv; ++v) Y_.row(v) = surface_position(m_, sp_[static_cast<size_t>(v)]).transpose();
+    // Template faces around each template vertex, for the validity check of a move.
+    tvf_ = std::make_unique<VertexFaces>(t_);
+    init_rest();
+  }
+
+  // Runs the rounds (q() then holds one unit vector per template vertex).
+  // Each round: best rotations for the current surface points (local step), then one
+  // Gauss-Newton step of the rigidity energy with every free point moving in the tangent
+  // plane of the member's surface at it (two unknowns per point; the step stays on the
+  // surface to first order, so low-frequency slides, which the energy penalizes only
+  // weakly, are not lost to motion off the surface), Levenberg-damped by `damping`; each
+  // point then walks on the surface to the point nearest its stepped position.
+  Status run(const std::function<bool()>& keep_going, double* e_before, double* e_after) {
+    const int nv = static_cast<int>(t_.V.rows());
+    std::vector<int> index(static_cast<size_t>(nv), -1);
+    int nf = 0;
+    for (int v = 0; v < nv; ++v)
+      if (!fixed_[static_cast<size_t>(v)]) index[static_cast<size_t>(v)] = nf++;
+    const double mu = o_.damping * metric_.mean_diag / metric_.mean_area;
+    std::vector<Eigen::Matrix3d> R(static_cast<size_t>(nv));
+    rotations(R);
+    *e_before = sd_total();
+    std::vector<Eigen::Matrix<double, 3, 2>> T(static_cast<size_t>(nv));
+    std::vector<Eigen::Triplet<double>> trip;
+    Eigen::VectorXd g(2 * nf);
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
+    for (int it = 0; it < o_.iterations && nf > 0; ++it) {
+      if (!keep_going()) return Status(ErrorCode::Cancelled, "cancelled");
+      if (it > 0) rotations(R);
+      for (int v = 0; v < nv; ++v) T[static_cast<size_t>(v)] = tangent_basis(sp_[static_cast<size_t>(v)].face);
+      trip.clear();
+      g.setZero();
+      for (int v = 0; v < nv; ++v) {
+        const int iv = index[static_cast<size_t>(v)];
+        if (iv >= 0) {
+          const double d = mu * metric_.area[static_cast<size_t>(v)];
+          trip.emplace_back(2 * iv, 2 * iv, d);
+          trip.emplace_back(2 * iv + 1, 2 * iv + 1, d);
+        }
+        const Vec3 xv = t_.V.row(v).transpose(), yv = Y_.row(v).transpose();
+        for (int k = metric_.start[static_cast<size_t>(v)]; k < metric_.start[static_cast<size_t>(v) + 1]; ++k) {
+          const int j = metric_.nbr[static_cast<size_t>(k)];
+          if (j < v) continue;  // each spoke once
+          const int ij = index[static_cast<size_t>(j)];
+          const double wt = metric_.w[static_cast<size_t>(k)];
+          const Vec3 c = (yv - Y_.row(j).transpose()) -
+                         0.5 * (R[static_cast<size_t>(v)] + R[static_cast<size_t>(j)]) * (xv - t_.V.row(j).transpose());
+          const auto& Tv = T[static_cast<size_t>(v)];
+          const auto& Tj = T[static_cast<size_t>(j)];
+          if (iv >= 0) {
+            for (int a = 0; a < 2; ++a) trip.emplace_back(2 * iv + a, 2 * iv + a, wt);
+            g.segment<2>(2 * iv) += wt * Tv.transpose() * c;
+          }
+          if (ij >= 0) {
+            for (int a = 0; a < 2; ++a) trip.emplace_back(2 * ij + a, 2 * ij + a, wt);
+            g.segment<2>(2 * ij) -= wt * Tj.transpose() * c;
+          }
+          if (iv >= 0 && ij >= 0) {
+            const Eigen::Matrix2d B = -wt * Tv.transpose() * Tj;
+            for (int a = 0; a < 2; ++a)
+              for (int b = 0; b < 2; ++b) {
+                trip.emplace_back(2 * iv + a, 2 * ij + b, B(a, b));
+                trip.emplace_back(2 * ij + b, 2 * iv + a, B(a, b));
+              }
+          }
+        }
+      }
+      Eigen::SparseMatrix<double> H(2 * nf, 2 * nf);
+      H.setFromTriplets(trip.begin(), trip.end());
+      if (it == 0) solver.analyzePattern(H);
+      solver.factorize(H);
+      if (solver.info() != Eigen::Success) return Status(ErrorCode::SolverFailed, "rigidity system is not positive definite");
+      const Eigen::VectorXd step = solver.solve(-g);
+      // Move all points together (a slide of a whole region keeps the template's spherical
+      // triangulation valid only if its points move at once); points of faces that would be
+      // inverted go back, until every face is positive (exact predicate), and those then try
+      // half and quarter steps one at a time, in vertex order (deterministic).
+      std::vector<SurfacePoint> sp_new(sp_);
+      std::vector<Vec3> q_new(q_);
+      for (int v = 0; v < nv; ++v) {
+        const int iv = index[static_cast<size_t>(v)];
+        if (iv < 0) continue;
+        const Vec3 target = Y_.row(v).transpose() + T[static_cast<size_t>(v)] * step.segment<2>(2 * iv);
+        sp_new[static_cast<size_t>(v)] = walk_to_nearest(m_, vf_, sp_[static_cast<size_t>(v)], target);
+        q_new[static_cast<size_t>(v)] = sphere_point(m_, Si_, sp_new[static_cast<size_t>(v)]);
+      }
+      std::vector<char> back(static_cast<size_t>(nv), 0);
+      for (bool changed = true; changed;) {
+        changed = false;
+        for (Eigen::Index f = 0; f < t_.F.rows(); ++f) {
+          Vec3 p[3];
+          for (int c = 0; c < 3; ++c) {
+            const int u = t_.F(f, c);
+            p[c] = back[static_cast<size_t>(u)] ? q_[static_cast<size_t>(u)] : q_new[static_cast<size_t>(u)];
+          }
+          if (orient3d_origin(p[0], p[1], p[2]) > 0 && !worse_shape(static_cast<int>(f), back, sp_new)) continue;
+          for (int c = 0; c < 3; ++c) {
+            const int u = t_.F(f, c);
+            if (!back[static_cast<size_t>(u)] && index[static_cast<size_t>(u)] >= 0) back[static_cast<size_t>(u)] = 1, changed = true;
+          }
+        }
+      }
+      for (int v = 0; v < nv; ++v) {
+        if (index[static_cast<size_t>(v)] < 0 || back[static_cast<size_t>(v)]) continue;
+        sp_[static_cast<size_t>(v)] = sp_new[static_cast<size_t>(v)];
+        q_[static_cast<size_t>(v)] = q_new[static_cast<size_t>(v)];
+        Y_.row(v) = surface_position(m_, sp_[static_cast<size_t>(v)]).transpose();
+      }
+      for (int v = 0; v < nv; ++v) {
+        const int iv = index[static_cast<size_t>(v)];
+        if (iv < 0 || !back[static_cast<size_t>(v)]) continue;
+        const Vec3 delta = T[static_cast<size_t>(v)] * step.segment<2>(2 * iv);
+        for (double f : {0.5, 0.25}) {
+          const Vec3 target = Y_.row(v).transpose() + f * delta;
+          const SurfacePoint cand = walk_to_nearest(m_, vf_, sp_[static_cast<size_t>(v)], target);
+          const Vec3 qc = sphere_point(m_, Si_, cand);
+          if (valid_at(v, qc) && shape_ok_at(v, surface_position(m_, cand))) {
+            sp_[static_cast<size_t>(v)] = cand;
+            q_[static_cast<size_t>(v)] = qc;
+            Y_.row(v) = surface_position(m_, cand).transpose();
+            break;
+          }
+        }
+      }
+    }
+    *e_after = sd_total();
+    return Status();
+  }
+
+
+  // Symmetric Dirichlet energy of template face f carried onto the member (Y), with vertex
+  // v moved to y; infinite for a crushed image. tr(G) + tr(G^-1) of the image metric G in
+  // the face's rest frame: 4 for an isometry, a barrier against collapse.
+  double sd_face(int f, int v, const Vec3& y) const {
+    Vec3 p[3];
+    for (int c = 0; c < 3; ++c) {
+      const int u = t_.F(f, c);
+      p[c] = u == v ? y : Vec3(Y_.row(u).transpose());
+    }
+    const Eigen::Matrix2d& Gi = rest_inv_[static_cast<size_t>(f)];
+    const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+    Eigen::Matrix2d Gy;
+    Gy << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+    const double d = Gy.determinant() * rest_det_inv_[static_cast<size_t>(f)];
+    if (!(d > 0)) return std::numeric_limits<double>::infinity();
+    const double t = (Gi * Gy).trace();
+    return rest_area_[static_cast<size_t>(f)] * (t + t / d);
+  }
+  void init_rest() {
+    const Eigen::Index nfaces = t_.F.rows();
+    rest_inv_.resize(static_cast<size_t>(nfaces));
+    rest_det_inv_.resize(static_cast<size_t>(nfaces));
+    rest_area_.resize(static_cast<size_t>(nfaces));
+    for (Eigen::Index f = 0; f < nfaces; ++f) {
+      const Vec3 a = t_.V.row(t_.F(f, 0)).transpose();
+      const Vec3 e1 = Vec3(t_.V.row(t_.F(f, 1)).transpose()) - a, e2 = Vec3(t_.V.row(t_.F(f, 2)).transpose()) - a;
+      Eigen::Matrix2d G;
+      G << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+      const double det = G.determinant();
+      rest_area_[static_cast<size_t>(f)] = 0.5 * std::sqrt(std::max(det, 0.0));
+      rest_inv_[static_cast<size_t>(f)] = det > 0 ? Eigen::Matrix2d(G.inverse()) : Eigen::Matrix2d::Zero();
+      rest_det_inv_[static_cast<size_t>(f)] = det > 0 ? 1.0 / det : 0.0;
+    }
+  }
+  double sd_total() const {
+    double e = 0, a = 0;
+    for (Eigen::Index f = 0; f < t_.F.rows(); ++f) {
+      e += sd_face(static_cast<int>(f), -1, Vec3::Zero());
+      a += rest_area_[static_cast<size_t>(f)];
+    }
+    return a > 0 ? e / a : 0.0;
+  }
+
+  const std::vector<Vec3>& q() const { return q_; }
+
+ private:
+  // Best rotation per template vertex for the current Y; returns the energy / area.
+  double rotations(std::vector<Eigen::Matrix3d>& R) const {
+    const int nv = static_cast<int>(t_.V.rows());
+    double e = 0;
+    for (int v = 0; v < nv; ++v) {
+      Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+      const Vec3 xv = t_.V.row(v).transpose(), yv = Y_.row(v).transpose();
+      for (int k = metric_.start[static_cast<size_t>(v)]; k < metric_.start[static_cast<size_t>(v) + 1]; ++k) {
+        const int j = metric_.nbr[static_cast<size_t>(k)];
+        C += metric_.w[static_cast<size_t>(k)] * (xv - t_.V.row(j).transpose()) * (yv - Y_.row(j).transpose()).transpose();
+      }
+      Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      Eigen::Matrix3d U = svd.matrixU();
+      Eigen::Matrix3d Rv = svd.matrixV() * U.transpose();
+      if (Rv.determinant() < 0) {
+        U.col(2) = -U.col(2);
+        Rv = svd.matrixV() * U.transpose();
+      }
+      R[static_cast<size_t>(v)] = Rv;
+      for (int k = metric_.start[static_cast<size_t>(v)]; k < metric_.start[static_cast<size_t>(v) + 1]; ++k) {
+        const int j = metric_.nbr[static_cast<size_t>(k)];
+        e += metric_.w[static_cast<size_t>(k)] *
+             ((yv - Y_.row(j).transpose()) - Rv * (xv - t_.V.row(j).transpose())).squaredNorm();
+      }
+    }
+    return metric_.total_area > 0 ? e / metric_.total_area : 0.0;
+  }
+
+  // A face's shape after a joint move is refused when its symmetric Dirichlet density
+  // passes kShapeCap and its value before (the rigidity step has no barrier against
+  // collapse; a nearly collapsed face makes the composed map nearly singular there).
+  static constexpr double kShapeCap = 32;
+  double sd_density(int f, const Vec3* p) const {
+    const Eigen::Matrix2d& Gi = rest_inv_[static_cast<size_t>(f)];
+    const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+    Eigen::Matrix2d Gy;
+    Gy << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+    const double d = Gy.determinant() * rest_det_inv_[static_cast<size_t>(f)];
+    if (!(d > 0)) return std::numeric_limits<double>::infinity();
+    const double t = (Gi * Gy).trace();
+    return t + t / d;
+  }
+  bool worse_shape(int f, const std::vector<char>& back, const std::vector<SurfacePoint>& sp_new) const {
+    Vec3 before[3], after[3];
+    for (int c = 0; c < 3; ++c) {
+      const int u = t_.F(f, c);
+      before[c] = Y_.row(u).transpose();
+      after[c] = back[static_cast<size_t>(u)] ? before[c] : surface_position(m_, sp_new[static_cast<size_t>(u)]);
+    }
+    const double a = sd_density(f, after);
+    return a > kShapeCap && a > sd_density(f, before);
+  }
+  bool shape_ok_at(int v, const Vec3& y) const {
+    for (int k = tvf_->start[static_cast<size_t>(v)]; k < tvf_->start[static_cast<size_t>(v) + 1]; ++k) {
+      const int f = tvf_->face[static_cast<size_t>(k)];
+      Vec3 before[3], after[3];
+      for (int c = 0; c < 3; ++c) {
+        const int u = t_.F(f, c);
+        before[c] = Y_.row(u).transpose();
+        after[c] = u == v ? y : before[c];
+      }
+      const double a = sd_density(f, after);
+      if (a > kShapeCap && a > sd_density(f, before)) return false;
+    }
+    return true;
+  }
+
+  // Orthonormal basis of the plane of member face f.
+  Eigen::Matrix<double, 3, 2> tangent_basis(int f) const {
+    const Vec3 a = m_.V.row(m_.F(f, 0)).transpose(), b = m_.V.row(m_.F(f, 1)).transpose(),
+               c = m_.V.row(m_.F(f, 2)).transpose();
+    Vec3 n = (b - a).cross(c - a);
+    if (!(n.norm() > 0)) n = Vec3::UnitZ();
+    n.normalize();
+    Vec3 u = (b - a) - (b - a).dot(n) * n;
+    if (!(u.norm() > 0)) u = n.unitOrthogonal();
+    u.normalize();
+    Eigen::Matrix<double, 3, 2> T;
+    T.col(0) = u;
+    T.col(1) = n.cross(u);
+    return T;
+  }
+
+  // Every template face around v stays positively oriented with v at qc (exact predicate).
+  bool valid_at(int v, const Vec3& qc) const {
+    for (int k = tvf_->start[static_cast<size_t>(v)]; k < tvf_->start[static_cast<size_t>(v) + 1]; ++k) {
+      const int f = tvf_->face[static_cast<size_t>(k)];
+      Vec3 p[3];
+      for (int c = 0; c < 3; ++c) {
+        const int u = t_.F(f, c);
+        p[c] = u == v ? qc : q_[static_cast<size_t>(u)];
+      }
+      if (orient3d_origin(p[0], p[1], p[2]) <= 0) return false;
+    }
+    return true;
+  }
+
+  const TriMesh& t_;
+  const RowMat3d& St_;
+  const TemplateMetric& metric_;
+  const TriMesh& m_;
+  const RowMat3d& Si_;
+  VertexFaces vf_;
+  std::unique_ptr<VertexFaces> tvf_;
+  const RefineCorrespondenceOptions& o_;
+  std::vector<Vec3> q_;
+  std::vector<SurfacePoint> sp_;
+  RowMat3d Y_;
+  std::vector<char> fixed_;
+  std::vector<Eigen::Matrix2d> rest_inv_;
+  std::vector<double> rest_det_inv_, rest_area_;
+};
+
+// Member i's map composed with psi^-1, where psi sends the template's sphere points St to
+// Q (both triangulated by the template's faces). Features get their exact F.
+RowMat3d compose(const TriMesh& tmpl, const RowMat3d& St, const RowMat3d& Q, const RowMat3d& Si,
+                 const std::vector<int>& feat, const std::vector<int>& tfeat) {
+  const SphereLocator locator(tmpl.F, Q);
+  RowMat3d out(Si.rows(), 3);
+  for (Eigen::Index w = 0; w < Si.rows(); ++w) {
+    const SphereLocation loc = locator.locate(Si.row(w).transpose());
+    Vec3 s = Vec3::Zero();
+    for (int c = 0; c < 3; ++c) s += loc.bary[c] * St.row(tmpl.F(loc.face, c)).transpose();
+    out.row(w) = s.normalized().transpose();
+  }
+  for (size_t k = 0; k < feat.size(); ++k) out.row(feat[k]) = St.row(tfeat[k]);
+  return out;
+}
+
+constexpr int kMinSamples = 32;
+constexpr double kMinEfficiencyRatio = 0.8;
+
+std::string format_fixed(double x, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, x);
+  return buf;
+}
+
+// `count` well-spread vertices of the mesh (farthest-point samples by straight distance,
+// starting from the features, which are not returned), ascending.
+std::vector<int> surface_samples(const TriMesh& m, const std::vector<int>& feat, int count) {
+  const Eigen::Index nv = m.V.rows();
+  std::vector<double> d(static_cast<size_t>(nv), std::numeric_limits<double>::infinity());
+  auto take = [&](int s) {
+    for (Eigen::Index v = 0; v < nv; ++v) d[static_cast<size_t>(v)] = std::min(d[static_cast<size_t>(v)], (m.V.row(v) - m.V.row(s)).squaredNorm());
+  };
+  for (int f : feat) take(f);
+  if (feat.empty()) take(0);
+  std::vector<int> out;
+  while (static_cast<int>(out.size()) < std::min<Eigen::Index>(count, nv - static_cast<Eigen::Index>(feat.size()))) {
+    const int next = static_cast<int>(std::max_element(d.begin(), d.end()) - d.begin());
+    if (!(d[static_cast<size_t>(next)] > 0)) break;
+    out.push_back(next);
+    take(next);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMesh>& meshes,
+                                                         const std::vector<std::vector<int>>& features,
+                                                         std::vector<RowMat3d>& maps,
+                                                         const RefineCorrespondenceOptions& options,
+                                                         const ProgressFn& progress) {
+  const auto t_start = std::chrono::steady_clock::now();
+  const int n = static_cast<int>(meshes.size());
+  if (features.size() != meshes.size() || maps.size() != meshes.size())
+    return Status(ErrorCode::InvalidArgument, "need one feature list and one map per mesh");
+  const int t = options.template_mesh;
+  if (t < 0 || t >= n) return Status(ErrorCode::InvalidArgument, "template " + std::to_string(t) + " is not a mesh index");
+  if (options.iterations < 0 || !(options.damping > 0))
+    return Status(ErrorCode::InvalidArgument, "iterations must be >= 0 and damping > 0");
+  for (int i = 0; i < n; ++i) {
+    if (maps[static_cast<size_t>(i)].rows() != meshes[static_cast<size_t>(i)].V.rows())
+      return Status(ErrorCode::InvalidArgument, "mesh " + std::to_string(i) + ": map and mesh sizes differ");
+    if (features[static_cast<size_t>(i)].size() != features[static_cast<size_t>(t)].size())
+      return Status(ErrorCode::InvalidArgument, "mesh " + std::to_string(i) + ": feature count differs");
+    for (int v : features[static_cast<size_t>(i)])
+      if (v < 0 || v >= meshes[static_cast<size_t>(i)].V.rows())
+        return Status(ErrorCode::InvalidArgument, "mesh " + std::to_string(i) + ": feature vertex out of range");
+  }
+  RefineCorrespondenceResult result;
+  result.members.resize(static_cast<size_t>(n));
+  result.members[static_cast<size_t>(t)].note = "template";
+  const TriMesh& tmpl = meshes[static_cast<size_t>(t)];
+  if (has_boundary(tmpl.F)) {
+    for (int i = 0; i < n; ++i)
+      if (i != t) result.members[static_cast<size_t>(i)].note = "the template has holes";
+    result.seconds = seconds_since(t_start);
+    return result;
+  }
+  const TemplateMetric metric = template_metric(tmpl);
+  const RowMat3d& St = maps[static_cast<size_t>(t)];
+  std::vector<int> others;
+  for (int i = 0; i < n; ++i)
+    if (i != t) others.push_back(i);
+  SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics tm, evaluate_sphere_map(tmpl, St));
+  const double template_efficiency = tm.efficiency;
+  std::vector<RowMat3d> refined(static_cast<size_t>(n));
+  const Status s = detail::run_parallel_jobs(
+      static_cast<int>(others.size()), options.threads, "refine correspondence", progress,
+      [&](int j, int, const std::function<bool()>& keep_going) -> Status {
+        const int i = others[static_cast<size_t>(j)];
+        const auto t0 = std::chrono::steady_clock::now();
+        RefinedMember& rep = result.members[static_cast<size_t>(i)];
+        const TriMesh& mi = meshes[static_cast<size_t>(i)];
+        const std::vector<int>& fi = features[static_cast<size_t>(i)];
+        RowMat3d cur = maps[static_cast<size_t>(i)];
+        SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics m0, evaluate_sphere_map(mi, cur));
+        rep.efficiency_before = rep.efficiency_after = m0.efficiency;
+        const double bar = std::min(m0.efficiency, template_efficiency);
+        int samples = options.samples;
+        for (int round = 0; round < options.rounds; ++round) {
+          MemberFit fit(tmpl, St, metric, features[static_cast<size_t>(t)], mi, cur, fi, options);
+          double e0 = 0, e1 = 0;
+          SPHEREKIT_RETURN_IF_ERROR(fit.run(keep_going, &e0, &e1));
+          if (round == 0) rep.energy_before = rep.energy_after = e0;
+          RowMat3d Q(St.rows(), 3);
+          for (Eigen::Index v = 0; v < St.rows(); ++v) Q.row(v) = fit.q()[static_cast<size_t>(v)].transpose();
+          // The fitted correspondence, exact but rough at the template's triangle scale
+          // (each point is stopped where a move would invert or collapse a face), is taken
+          // at well-spread samples only, and the member's map flows onto those targets
+          // smoothly (the feature warp: compactly supported radial-basis flow, every step
+          // checked with the exact predicate), the features standing still. A flow that
+          // cannot finish (a sliver it cannot carry) is tried again with half the samples.
+          const RowMat3d Sc = compose(tmpl, St, Q, cur, fi, features[static_cast<size_t>(t)]);
+          Status st;
+          RowMat3d S;
+          for (; samples >= kMinSamples; samples /= 2) {
+            const std::vector<int> W = surface_samples(mi, fi, samples);
+            std::vector<int> fv(fi);
+            std::vector<Vec3> targets;
+            for (int v : fv) targets.push_back(cur.row(v).transpose());
+            for (int w : W) fv.push_back(w), targets.push_back(Sc.row(w).transpose());
+            S = cur;
+            st = detail::warp_features_to_targets(mi.V, mi.F, fv, targets, {}, &S);
+            if (st.ok() || st.code() == ErrorCode::Cancelled || !keep_going()) break;
+          }
+          if (!keep_going()) return Status(ErrorCode::Cancelled, "cancelled");
+          if (!st.ok()) {
+            rep.note = "round " + std::to_string(round + 1) + ": " + st.message();
+            break;
+          }
+          // Stretch is what the member's geometry image and every asset sample through: a
+          // round that leaves less than kMinEfficiencyRatio of the starting efficiency is not
+          // taken. The start is the lower of the member's and the template's: maps that agree
+          // carry the template's distortion, so no member can be expected to end better
+          // than the template is.
+          SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics m1, evaluate_sphere_map(mi, S));
+          if (m1.flipped != 0 || m1.efficiency < kMinEfficiencyRatio * bar) {
+            rep.note = "round " + std::to_string(round + 1) + " not taken: efficiency " + format_fixed(m1.efficiency, 4) +
+                       " below 0.8 x " + format_fixed(bar, 4);
+            break;
+          }
+          cur = std::move(S);
+          rep.refined = true;
+          rep.rounds = round + 1;
+          rep.samples = samples;
+          rep.energy_after = e1;
+          rep.efficiency_after = m1.efficiency;
+        }
+        if (rep.refined) refined[static_cast<size_t>(i)] = std::move(cur);
+        rep.seconds = seconds_since(t0);
+        return Status();
+      });
+  SPHEREKIT_RETURN_IF_ERROR(s);
+  for (int i : others)
+    if (result.members[static_cast<size_t>(i)].refined) maps[static_cast<size_t>(i)] = std::move(refined[static_cast<size_t>(i)]);
+  result.seconds = seconds_since(t_start);
+  return result;
+}
+
+}  // namespace spherekit

@@ -186,6 +186,29 @@ std::vector<int> snap_texels(const std::vector<Eigen::Vector3d>& locations, int 
   return texel;
 }
 
+}  // namespace
+
+Status replace_refined_map(const TriMesh& mesh, const std::vector<int>& feature_vertices,
+                           const std::vector<Eigen::Vector3d>& locations, RowMat3d S, ConstrainedParamResult* map) {
+  if (locations.size() != feature_vertices.size())
+    return Status(ErrorCode::InvalidArgument, "need one location per feature vertex");
+  SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics mm, evaluate_sphere_map(mesh, S));
+  map->map.S = std::move(S);
+  map->flipped_faces = count_flipped_faces(mesh.F, map->map.S);
+  map->efficiency = mm.efficiency;
+  map->l2_stretch = mm.l2_stretch;
+  map->linf_stretch = mm.linf;
+  map->winding = mm.winding;
+  map->max_feature_angle = 0;
+  for (size_t f = 0; f < feature_vertices.size(); ++f) {
+    const Eigen::Vector3d s = map->map.S.row(feature_vertices[f]).transpose();
+    map->max_feature_angle = std::max(map->max_feature_angle, std::atan2(s.cross(locations[f]).norm(), s.dot(locations[f])));
+  }
+  return Status();
+}
+
+namespace {
+
 // The correspondence refinement after the last step (refine_correspondence.h), the measures
 // of every refined map recomputed.
 Status refine_maps(const std::vector<TriMesh>& meshes, const std::vector<std::vector<int>>& features,
@@ -199,24 +222,11 @@ Status refine_maps(const std::vector<TriMesh>& meshes, const std::vector<std::ve
   std::vector<RowMat3d> S(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) S[static_cast<size_t>(i)] = result->maps[static_cast<size_t>(i)].map.S;
   SPHEREKIT_ASSIGN_OR_RETURN(result->refinement, refine_correspondence(meshes, features, S, ro, progress));
-  for (int i = 0; i < n; ++i) {
-    if (!result->refinement.members[static_cast<size_t>(i)].refined) continue;
-    ConstrainedParamResult& m = result->maps[static_cast<size_t>(i)];
-    SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics mm,
-                               evaluate_sphere_map(meshes[static_cast<size_t>(i)], S[static_cast<size_t>(i)]));
-    m.map.S = std::move(S[static_cast<size_t>(i)]);
-    m.flipped_faces = count_flipped_faces(meshes[static_cast<size_t>(i)].F, m.map.S);
-    m.efficiency = mm.efficiency;
-    m.l2_stretch = mm.l2_stretch;
-    m.linf_stretch = mm.linf;
-    m.winding = mm.winding;
-    m.max_feature_angle = 0;
-    for (size_t f = 0; f < features[static_cast<size_t>(i)].size(); ++f) {
-      const Eigen::Vector3d s = m.map.S.row(features[static_cast<size_t>(i)][f]).transpose();
-      const Eigen::Vector3d& F = result->final_locations[f];
-      m.max_feature_angle = std::max(m.max_feature_angle, std::atan2(s.cross(F).norm(), s.dot(F)));
-    }
-  }
+  for (int i = 0; i < n; ++i)
+    if (result->refinement.members[static_cast<size_t>(i)].refined)
+      SPHEREKIT_RETURN_IF_ERROR(replace_refined_map(meshes[static_cast<size_t>(i)], features[static_cast<size_t>(i)],
+                                                    result->final_locations, std::move(S[static_cast<size_t>(i)]),
+                                                    &result->maps[static_cast<size_t>(i)]));
   result->times.refinement = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return Status();
 }

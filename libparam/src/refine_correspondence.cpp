@@ -33,18 +33,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-bool has_boundary(const RowMat3i& F) {
-  std::map<std::pair<int, int>, int> count;
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int c = 0; c < 3; ++c) {
-      const int a = F(f, c), b = F(f, (c + 1) % 3);
-      ++count[{std::min(a, b), std::max(a, b)}];
-    }
-  for (const auto& [edge, n] : count)
-    if (n != 2) return true;
-  return false;
-}
-
 // The template's rigidity metric: symmetric spoke weights (cotangent, clamped to a small
 // positive floor so that the system stays positive definite on poor triangulations), the
 // spokes as CSR, and lumped vertex areas.
@@ -471,12 +459,16 @@ class MemberFit {
 
 // Member i's map composed with psi^-1, where psi sends the template's sphere points St to
 // Q (both triangulated by the template's faces). Features get their exact F.
+// `inside[w]` is 0 where member vertex w falls in a hole of the template (no template face
+// covers its sphere point there; its row is then only the nearest face's nearest point).
 RowMat3d compose(const TriMesh& tmpl, const RowMat3d& St, const RowMat3d& Q, const RowMat3d& Si,
-                 const std::vector<int>& feat, const std::vector<int>& tfeat) {
+                 const std::vector<int>& feat, const std::vector<int>& tfeat, std::vector<char>* inside) {
   const SphereLocator locator(tmpl.F, Q);
   RowMat3d out(Si.rows(), 3);
+  inside->assign(static_cast<size_t>(Si.rows()), 1);
   for (Eigen::Index w = 0; w < Si.rows(); ++w) {
     const SphereLocation loc = locator.locate(Si.row(w).transpose());
+    (*inside)[static_cast<size_t>(w)] = loc.inside ? 1 : 0;
     Vec3 s = Vec3::Zero();
     for (int c = 0; c < 3; ++c) s += loc.bary[c] * St.row(tmpl.F(loc.face, c)).transpose();
     out.row(w) = s.normalized().transpose();
@@ -543,12 +535,6 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
   result.members.resize(static_cast<size_t>(n));
   result.members[static_cast<size_t>(t)].note = "template";
   const TriMesh& tmpl = meshes[static_cast<size_t>(t)];
-  if (has_boundary(tmpl.F)) {
-    for (int i = 0; i < n; ++i)
-      if (i != t) result.members[static_cast<size_t>(i)].note = "the template has holes";
-    result.seconds = seconds_since(t_start);
-    return result;
-  }
   const TemplateMetric metric = template_metric(tmpl);
   const RowMat3d& St = maps[static_cast<size_t>(t)];
   std::vector<int> others;
@@ -583,7 +569,8 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           // smoothly (the feature warp: compactly supported radial-basis flow, every step
           // checked with the exact predicate), the features standing still. A flow that
           // cannot finish (a sliver it cannot carry) is tried again with half the samples.
-          const RowMat3d Sc = compose(tmpl, St, Q, cur, fi, features[static_cast<size_t>(t)]);
+          std::vector<char> inside;
+          const RowMat3d Sc = compose(tmpl, St, Q, cur, fi, features[static_cast<size_t>(t)], &inside);
           Status st;
           RowMat3d S;
           for (; samples >= kMinSamples; samples /= 2) {
@@ -591,7 +578,8 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
             std::vector<int> fv(fi);
             std::vector<Vec3> targets;
             for (int v : fv) targets.push_back(cur.row(v).transpose());
-            for (int w : W) fv.push_back(w), targets.push_back(Sc.row(w).transpose());
+            for (int w : W)  // a sample in a hole of the template has no partner: it is not a target
+              if (inside[static_cast<size_t>(w)]) fv.push_back(w), targets.push_back(Sc.row(w).transpose());
             S = cur;
             st = detail::warp_features_to_targets(mi.V, mi.F, fv, targets, {}, &S);
             if (st.ok() || st.code() == ErrorCode::Cancelled || !keep_going()) break;
@@ -601,6 +589,9 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
             rep.note = "round " + std::to_string(round + 1) + ": " + st.message();
             break;
           }
+          // The warp lands features on their normalized targets, which can differ from
+          // the given unit vectors in the last bit: features stay exactly where they were.
+          for (int v : fi) S.row(v) = cur.row(v);
           // Stretch is what the member's geometry image and every asset sample through: a
           // round that leaves less than kMinEfficiencyRatio of the starting efficiency is not
           // taken. The start is the lower of the member's and the template's: maps that agree

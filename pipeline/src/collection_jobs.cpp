@@ -6,6 +6,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <set>
 
 #include "sample_collection.h"
@@ -177,6 +178,41 @@ Json refinement_json(const RefinedMember& m) {
   j["efficiency_before"] = m.efficiency_before;
   j["efficiency_after"] = m.efficiency_after;
   return j;
+}
+
+// `add` in a collection made with the correspondence refinement: the new member's map is
+// refined against the reference member, as `consistent` refined every member (one
+// template, so an added member agrees with the others as theirs do). Reads the reference's
+// mesh and map (O(1) reads per add). No refinement (nullopt): the collection was made
+// without it, or has no reference member (other than the one being replaced).
+Result<std::optional<RefinedMember>> refine_added_member(const formats::Collection& c, int replacing, const TriMesh& mesh,
+                                                         const std::vector<int>& fv, const std::vector<Eigen::Vector3d>& F,
+                                                         const ProgressFn& progress, ConstrainedParamResult* map) {
+  const Json& opt = c.manifest.options;
+  if (!opt.is_object() || !opt.value("refine_correspondence", false) || !c.manifest.reference)
+    return std::optional<RefinedMember>{};
+  const int ref = c.manifest.member_index(*c.manifest.reference);
+  if (ref < 0 || ref == replacing || !c.manifest.members[static_cast<size_t>(ref)].feature_vertices)
+    return std::optional<RefinedMember>{};
+  SPHEREKIT_ASSIGN_OR_RETURN(formats::LoadedMember rm, formats::load_collection_member(c, ref));
+  std::vector<int> rf;
+  for (long long v : *c.manifest.members[static_cast<size_t>(ref)].feature_vertices) rf.push_back(static_cast<int>(v));
+  RefineCorrespondenceOptions ro;
+  if (opt.contains("refinement") && opt["refinement"].is_object()) {
+    const Json& r = opt["refinement"];
+    ro.iterations = r.value("iterations", ro.iterations);
+    ro.damping = r.value("damping", ro.damping);
+    ro.rounds = r.value("rounds", ro.rounds);
+    ro.samples = r.value("samples", ro.samples);
+  }
+  ro.template_mesh = 0;
+  ro.threads = 1;
+  std::vector<TriMesh> meshes{std::move(rm.mesh), mesh};
+  std::vector<std::vector<int>> features{rf, fv};
+  std::vector<RowMat3d> maps{std::move(rm.map.S), map->map.S};
+  SPHEREKIT_ASSIGN_OR_RETURN(RefineCorrespondenceResult rr, refine_correspondence(meshes, features, maps, ro, progress));
+  if (rr.members[1].refined) SPHEREKIT_RETURN_IF_ERROR(replace_refined_map(mesh, fv, F, std::move(maps[1]), map));
+  return std::optional<RefinedMember>(rr.members[1]);
 }
 
 formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const ConsistentParamOptions& o,
@@ -366,6 +402,14 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
     out.map = std::move(result).value();
     SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
     e.result = map_entry_json(out.map);
+    if (a.refine_correspondence) {
+      SPHEREKIT_ASSIGN_OR_RETURN(std::optional<RefinedMember> refined,
+                                 refine_added_member(c, existing, mesh, fv, F, progress, &out.map));
+      if (refined) {
+        e.result = map_entry_json(out.map);
+        e.result["correspondence_refinement"] = refinement_json(*refined);
+      }
+    }
     u.write_map = [&](const std::string& path) { return formats::write_sphere_map(path, mesh, out.map.map); };
   }
   u.member = std::move(e);

@@ -166,18 +166,31 @@ void bind_param(pyb::module_& m) {
         return pyb::dict(pyb::arg("step1_reference") = t.reference, pyb::arg("step2_initial_maps") = t.initial,
                          pyb::arg("step3_remesh") = t.remesh, pyb::arg("step4_concatenate") = t.concatenate,
                          pyb::arg("step5_joint_map") = t.joint, pyb::arg("step6_final_maps") = t.final_maps,
-                         pyb::arg("total") = t.total);
+                         pyb::arg("refine_correspondence") = t.refinement, pyb::arg("total") = t.total);
+      })
+      .def_property_readonly("refinement", [](const ConsistentParamResult& r) {
+        // What the correspondence refinement did, per mesh (empty when it did not run).
+        pyb::list out;
+        for (const RefinedMember& m : r.refinement.members)
+          out.append(pyb::dict(pyb::arg("refined") = m.refined, pyb::arg("note") = m.note, pyb::arg("rounds") = m.rounds,
+                               pyb::arg("samples") = m.samples, pyb::arg("energy_before") = m.energy_before,
+                               pyb::arg("energy_after") = m.energy_after,
+                               pyb::arg("efficiency_before") = m.efficiency_before,
+                               pyb::arg("efficiency_after") = m.efficiency_after, pyb::arg("seconds") = m.seconds));
+        return out;
       });
 
   m.def(
       "consistent",
       [](const std::vector<Mesh>& meshes, const std::vector<std::vector<int>>& features, int reference, int remesh_size,
-         bool refine_locations, int effort, std::uint64_t seed, int threads, Callback progress) {
+         bool refine_locations, bool refine_correspondence, int effort, std::uint64_t seed, int threads,
+         Callback progress) {
         ConsistentParamOptions o;
         o.constrained.sphere = sphere_options(effort, seed, threads, SphereParamOptions{}.regularizer_weight);
         o.reference = reference;
         o.remesh_size = remesh_size;
         o.refine_locations = refine_locations;
+        o.refine_correspondence = refine_correspondence;
         o.threads = threads;
         std::vector<TriMesh> tri;
         for (const Mesh& mesh : meshes) tri.push_back(mesh.mesh);
@@ -198,9 +211,10 @@ void bind_param(pyb::module_& m) {
         return std::move(result).value();
       },
       pyb::arg("meshes"), pyb::arg("features"), pyb::kw_only(), pyb::arg("reference") = 0, pyb::arg("remesh_size") = 65,
-      pyb::arg("refine_locations") = true, pyb::arg("effort") = 2, pyb::arg("seed") = 1, pyb::arg("threads") = 0,
-      pyb::arg("progress") = pyb::none(),
-      "Consistent maps of a collection (the paper's six steps; as `spherekit consistent`): features[i] lists\n"
+      pyb::arg("refine_locations") = true, pyb::arg("refine_correspondence") = true, pyb::arg("effort") = 2,
+      pyb::arg("seed") = 1, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
+      "Consistent maps of a collection (the paper's six steps, then the correspondence refinement; as\n"
+      "`spherekit consistent`): features[i] lists\n"
       "mesh i's feature vertices, in the same order (same names) for every mesh.");
 
   pyb::class_<SphereMapMetrics>(m, "SphereMapMetrics")

@@ -104,6 +104,35 @@ TEST_CASE("consistent writes a collection; add grows it; correspond uses it", "[
   man = read_json(col + "/collection.json");
   REQUIRE(man["meshes"].size() == 3);
   CHECK(man["meshes"][2]["added"] == true);
+  // The collection was made with the correspondence refinement (the default): consistent
+  // recorded it per member, and add refined the new map against the reference the same way.
+  CHECK(man["options"]["refine_correspondence"] == true);
+  CHECK(man["meshes"][0]["result"]["correspondence_refinement"]["note"] == "template");
+  for (int i : {1, 2}) {
+    INFO(man["meshes"][i]["name"]);
+    const json& cr = man["meshes"][i]["result"]["correspondence_refinement"];
+    REQUIRE(cr.is_object());
+    if (cr["refined"].get<bool>()) {
+      CHECK(cr["rounds"].get<int>() >= 1);
+      CHECK(man["meshes"][i]["result"]["efficiency"].get<double>() == Approx(cr["efficiency_after"].get<double>()));
+    }
+  }
+  // Without it (--no-refine-correspondence) add keeps the constrained map: no record, and a
+  // different map whenever the refined one was taken.
+  // (A copy of c's files, so that c_plain is its own source and `correspond` below finds c.)
+  fs::copy_file(s + "/sample_c.obj", s + "/c_plain.obj");
+  fs::copy_file(s + "/sample_c.lm.txt", s + "/c_plain.lm.txt");
+  r = sk("add " + q(col) + " " + q(s + "/c_plain.obj") + " --no-refine-correspondence --effort 1 -q", dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  man = read_json(col + "/collection.json");
+  REQUIRE(man["meshes"].size() == 4);
+  CHECK(man["meshes"][0]["name"] == "c_plain");  // sorted by name
+  CHECK_FALSE(man["meshes"][0]["result"].contains("correspondence_refinement"));
+  require_features_on_locations(s, col, "c_plain");
+  if (man["meshes"][3]["result"]["correspondence_refinement"]["refined"].get<bool>())
+    CHECK(slurp(col + "/c_plain.sphere.obj") != slurp(col + "/sample_c.sphere.obj"));
+
   // Adding it again is refused (exit 2), and the collection is unchanged.
   const std::string before = slurp(col + "/collection.json");
   r = sk("add " + q(col) + " " + q(s + "/sample_c.obj") + " -q", dir);

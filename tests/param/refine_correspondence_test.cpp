@@ -34,7 +34,9 @@ RowMat3d twisted(const RowMat3d& S, const Eigen::Vector3d& a, double amp) {
     const Eigen::Vector3d s = S.row(v).transpose();
     const double c = std::clamp(s.dot(a), -1.0, 1.0);
     const double turn = amp * (1 - c * c);
-    out.row(v) = (Eigen::AngleAxisd(turn, a) * s).transpose();
+    // The axis itself stays to the bit (a consistent pair: the feature on the same point).
+    const Eigen::Vector3d t = s == a ? s : Eigen::Vector3d(Eigen::AngleAxisd(turn, a) * s);
+    out.row(v) = t.transpose();
   }
   return out;
 }
@@ -131,27 +133,51 @@ TEST_CASE("refinement gives the same bits for any thread count", "[refine]") {
   for (size_t i = 0; i < one.size(); ++i) CHECK(one[i] == two[i]);
 }
 
-TEST_CASE("refinement leaves maps alone when the template has holes, and refuses bad arguments", "[refine]") {
-  const TriMesh holed = test::sphere_with_holes(3, 2);
+TEST_CASE("refinement works with holes in the template, and refuses bad arguments", "[refine]") {
+  TwistCase c = twist_case();
+  // Two holes (one face each, far from the feature) in both the template and the copy: the
+  // copy's points in the template's holes get no target; the rest is fitted as before.
+  std::vector<int> keep;
+  for (int f = 0; f < static_cast<int>(c.tmpl.F.rows()); ++f) {
+    bool far = true;
+    for (int k = 0; k < 3; ++k) far = far && c.tmpl.F(f, k) != c.feature;
+    if (!(far && (f == 40 || f == 400))) keep.push_back(f);
+  }
+  REQUIRE(keep.size() + 2 == static_cast<size_t>(c.tmpl.F.rows()));
+  RowMat3i F(static_cast<Eigen::Index>(keep.size()), 3);
+  for (size_t i = 0; i < keep.size(); ++i) F.row(static_cast<Eigen::Index>(i)) = c.tmpl.F.row(keep[i]);
+  c.tmpl.F = F;
+  c.copy.F = F;
   SphereParamOptions so;
   so.effort = 1;
   so.threads = 1;
-  auto r = parameterize_sphere(holed, so);
+  auto r = parameterize_sphere(c.tmpl, so);
   REQUIRE(r.ok());
-  std::vector<TriMesh> meshes{holed, holed};
-  std::vector<std::vector<int>> features{{0}, {0}};
-  std::vector<RowMat3d> maps{r->map.S, r->map.S};
+  const RowMat3d St = r->map.S;
+  const RowMat3d S1 = twisted(St, St.row(c.feature).transpose(), 0.5);
+  REQUIRE(count_flipped_faces(F, S1) == 0);
+  std::vector<TriMesh> meshes{c.tmpl, c.copy};
+  std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
+  std::vector<RowMat3d> maps{St, S1};
   auto out = refine_correspondence(meshes, features, maps);
   REQUIRE(out.ok());
-  CHECK_FALSE(out->members[1].refined);
-  CHECK(out->members[1].note == "the template has holes");
-  CHECK(maps[1] == r->map.S);
+  INFO(out->members[1].note);
+  REQUIRE(out->members[1].refined);
+  CHECK(count_flipped_faces(F, maps[1]) == 0);
+  CHECK(maps[1].row(c.feature) == St.row(c.feature));
+  const double before = copy_error(c.tmpl, St, c.copy, S1), after = copy_error(c.tmpl, St, c.copy, maps[1]);
+  INFO("error before " << before << ", after " << after);
+  CHECK(after < 0.35 * before);
 
   RefineCorrespondenceOptions bad;
   bad.template_mesh = 2;
+  const TriMesh holed = c.tmpl;
   auto e = refine_correspondence(meshes, features, maps, bad);
   REQUIRE_FALSE(e.ok());
   CHECK(e.status().code() == ErrorCode::InvalidArgument);
   std::vector<std::vector<int>> out_of_range{{0}, {static_cast<int>(holed.V.rows())}};
+  bad.template_mesh = 0;
+  bad.damping = 0;
+  CHECK(refine_correspondence(meshes, features, maps, bad).status().code() == ErrorCode::InvalidArgument);
   CHECK(refine_correspondence(meshes, out_of_range, maps).status().code() == ErrorCode::InvalidArgument);
 }

@@ -130,6 +130,8 @@ void register_consistent(CLI::App& app) {
   add->add_option("--features", add_args->job.features, "its feature file (default: MESH stem + .lm.txt)");
   add->add_option("--name", add_args->job.name, "member name (default: the mesh's file stem)");
   add->add_flag("--replace", add_args->job.replace, "map again if the collection has a member of that name");
+  add->add_flag("!--no-refine-correspondence", add_args->job.refine_correspondence,
+                "do not refine the new map against the reference member (done when the collection was made with it)");
   add->add_option("--map", add_args->job.map,
                   "register this sphere map (computed elsewhere, e.g. by 'param --features F.lm.txt --targets "
                   "DIR/features.txt') instead of computing one; verified: same vertices and faces, bijective by the "

@@ -82,7 +82,9 @@ inline constexpr const char* kAdd =
     "feature file (default NAME.lm.txt beside the mesh) must name every feature of the\n"
     "collection. Writes DIR/<stem>.sphere.obj and updates collection.json under the folder's lock\n"
     "(DIR/.collection.lock, held only around the manifest update), so that concurrent adds, e.g. the\n"
-    "tasks of a job array, all land. Reads only the manifest and F, not the other members' maps.\n"
+    "tasks of a job array, all land. Reads the manifest and F, and, when the collection was made\n"
+    "with the correspondence refinement, the reference member's mesh and map: the new map is\n"
+    "refined against it as `consistent` refined the others (--no-refine-correspondence: not).\n"
     "Members are kept sorted by name.";
 inline constexpr const char* kAddExamples =
     "  spherekit add cats cat10.obj\n"

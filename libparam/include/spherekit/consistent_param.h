@@ -87,6 +87,12 @@ struct ConsistentParamResult {
   ConsistentParamTimes times;
 };
 
+/// Replaces `map`'s sphere map by `S` (a refined map of the same mesh, refine_correspondence.h)
+/// and recomputes its measures (flips, efficiency, stretch, winding, feature angle against
+/// `locations`, one per entry of `feature_vertices`). Errors: those of evaluate_sphere_map().
+Status replace_refined_map(const TriMesh& mesh, const std::vector<int>& feature_vertices,
+                           const std::vector<Eigen::Vector3d>& locations, RowMat3d S, ConstrainedParamResult* map);
+
 /// Which mesh an error of parameterize_consistent() concerns, as a value: callers name the
 /// mesh their way (its file, its member name) without reading the message.
 struct MeshFailure {

@@ -79,9 +79,9 @@ struct RefineCorrespondenceResult {
 
 /// Refines the sphere maps `maps` (one #V by 3 array per mesh, consistent: feature k of
 /// every mesh on the same sphere point) in place. `features[i][k]` is mesh i's vertex of
-/// feature k. The template's map is not changed. When the template has boundaries (holes)
-/// nothing is changed (its sphere triangulation would not cover the sphere; each member's
-/// note says so). A member whose flow fails keeps its map (note says why).
+/// feature k. The template's map is not changed. Holes are allowed: template points that
+/// fall in a member's hole stay where they are, member samples that fall in a template's
+/// hole get no target. A member whose flow fails keeps its map (note says why).
 /// Errors: InvalidArgument (sizes, template index, options), Cancelled.
 /// Deterministic for any thread count.
 Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMesh>& meshes,

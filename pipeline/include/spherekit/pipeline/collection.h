@@ -65,6 +65,11 @@ struct AddToCollectionJob {
   /// `seed_given` (the caller chose one).
   ConstrainedParamOptions options;
   bool seed_given = false;
+  /// Refine the new map's correspondence against the collection's reference member
+  /// (refine_correspondence.h) when the collection was made with the refinement (its
+  /// options say so, with the refinement's settings); false: never. Registered maps (`map`)
+  /// are taken as given.
+  bool refine_correspondence = true;
 };
 
 struct AddToCollectionResult {

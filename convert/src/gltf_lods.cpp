@@ -14,6 +14,7 @@
 #include "gltf_document.h"
 #include "spherekit/convert/position_bits.h"
 #include "spherekit/convert/adaptive_lods.h"
+#include "spherekit/convert/original_lods.h"
 #include "spherekit/formats/atomic_file.h"
 
 namespace spherekit::convert {
@@ -24,7 +25,7 @@ tinygltf::Value level_extras(int level, int image_size, int texture_size, const 
                              bool has_normals) {
   tinygltf::Value::Object o;
   o["lod"] = detail::json_int(level);
-  o["lod_mode"] = detail::json_string(mode == LodMode::Adaptive ? "adaptive" : "uniform");
+  o["lod_mode"] = detail::json_string(mode == LodMode::Adaptive ? "adaptive" : mode == LodMode::Original ? "original" : "uniform");
   o["geometry_image_size"] = detail::json_int(image_size);
   o["texture_size"] = detail::json_int(texture_size);
   o["quantization"] = detail::quantization_json(q, has_normals, true);
@@ -135,6 +136,23 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
     levels.push_back(std::move(sub));
   }
   return build_gltf_lods(levels, options, progress);
+}
+
+Result<GltfLods> build_original_gltf_lods(const TriMesh& mesh, const RowMat3d& S, int texture_size,
+                                          const GltfLodOptions& options, const ProgressFn& progress) {
+  SPHEREKIT_RETURN_IF_ERROR(check_lod_options(texture_size, 1, options));
+  if (!(options.texcoord_max_error_texels > 0))
+    return Status(ErrorCode::InvalidArgument, "texture-coordinate error must be > 0 texels");
+  OriginalLodOptions a;
+  a.levels = options.levels;
+  a.texture_size = texture_size;
+  a.lod0_max_vertices = options.lod0_max_vertices;
+  SPHEREKIT_ASSIGN_OR_RETURN(std::vector<GltfMesh> meshes, original_lod_meshes(mesh, S, a, progress));
+  GltfLodOptions o = options;
+  o.mode = LodMode::Original;
+  o.reference_rms_error = 0;  // level 0 is the mesh itself; each level's error is its distance to it
+  return build_from_meshes(std::move(meshes), std::vector<int>(static_cast<std::size_t>(options.levels), texture_size),
+                           texture_size, o, progress, &mesh);
 }
 
 Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images, const GltfLodOptions& options,
@@ -248,6 +266,14 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
   all_points.position_index.clear();
   SPHEREKIT_ASSIGN_OR_RETURN(out.quantization,
                              choose_draco_quantization(all_points, options.reference_rms_error, options.budget));
+  if (options.mode == LodMode::Original && all_points.UV.rows() > 0) {
+    // Arbitrary texture coordinates on the UV box's grid (at most the texel lattice's span,
+    // (n-1)/n): b = ceil(log2((n-1) / (2 err))) bits, a step of about 2 err texels, so a
+    // coordinate moves by about err texels at most (n = 257, err = 0.5: 8 bits, 0.502 texel).
+    DracoQuantization& q = out.quantization.quantization;
+    const double steps = (n - 1) / (2.0 * options.texcoord_max_error_texels);
+    q.texcoord_bits = std::clamp(static_cast<int>(std::ceil(std::log2(std::max(steps, 1.0)) - 1e-9)), 1, 30);
+  }
   DracoEncodeOptions encode;
   encode.quantization = out.quantization.quantization;
   encode.compression_level = options.compression_level;

@@ -26,6 +26,7 @@ SphereParamOptions sphere_defaults(int effort, std::uint64_t seed, int threads) 
 convert::LodMode lod_mode(const std::string& name) {
   if (name == "uniform") return convert::LodMode::Uniform;
   if (name == "adaptive") return convert::LodMode::Adaptive;
+  if (name == "original") return convert::LodMode::Original;
   throw_status(Status(ErrorCode::InvalidArgument, "lod_mode must be 'uniform' or 'adaptive', not '" + name + "'"));
 }
 

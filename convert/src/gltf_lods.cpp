@@ -277,6 +277,7 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
   DracoEncodeOptions encode;
   encode.quantization = out.quantization.quantization;
   encode.compression_level = options.compression_level;
+  encode.smallest_texcoord_prediction = options.mode == LodMode::Original;
 
   // Rate-distortion bits need each level's error against the original: the finest remesh's
   // own (reference_rms_error) in squares with the level's distance to that remesh.

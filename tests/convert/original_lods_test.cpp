@@ -185,6 +185,19 @@ TEST_CASE("Original LODs: sizes and errors along the levels, texture-coordinate 
     CHECK(level.primitive.decoded.mesh.UV.rows() > 0);
     CHECK(level.primitive.decoded.mesh.N.rows() == 0);
   }
+  // Each level's bitstream is the smaller of Draco's two texture-coordinate predictors.
+  for (const GltfLodLevel& level : built->levels) {
+    DracoEncodeOptions e;
+    e.quantization = level.quantization.quantization;
+    e.compression_level = 7;
+    auto plain = encode_draco_primitive(level.mesh, e);
+    e.smallest_texcoord_prediction = true;
+    auto smallest = encode_draco_primitive(level.mesh, e);
+    REQUIRE(plain.ok());
+    REQUIRE(smallest.ok());
+    CHECK(smallest->bytes.size() <= plain->bytes.size());
+    CHECK(smallest->decoded.mesh.UV.rows() == plain->decoded.mesh.UV.rows());
+  }
   // Level 0 is the original up to the cut: the 14-bit grid's error alone.
   CHECK(remesh_psnr(b.mesh, TriMesh{built->levels[0].primitive.decoded.mesh.V, built->levels[0].primitive.decoded.mesh.F},
                     eo) > 80);

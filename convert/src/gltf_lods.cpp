@@ -297,8 +297,12 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
       const double e = std::sqrt(ref * ref + (std::isfinite(d) ? d * d : 0.0));
       level_errors.push_back(e);
     }
+    // Original levels: level 0 is the mesh itself (its tiny error is the cut's, not a
+    // simplification error, and put gamma at its 0.5 floor), so the rate curve runs from level
+    // 1 (bunny's coarsest level: 8 bits instead of 7, 1.36 -> 1.29 x gltf-transform at equal PSNR).
+    const std::size_t first = options.mode == LodMode::Original && levels > 2 ? 1 : 0;
     if (levels > 1)
-      gamma = rate_exponent(static_cast<double>(meshes.front().V.rows()), level_errors.front(),
+      gamma = rate_exponent(static_cast<double>(meshes[first].V.rows()), level_errors[first],
                             static_cast<double>(meshes.back().V.rows()), level_errors.back());
   }
 

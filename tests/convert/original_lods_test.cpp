@@ -4,6 +4,7 @@
 // holes kept open, texture-coordinate bits, determinism.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -107,8 +108,8 @@ TEST_CASE("Original LODs: the cut along the fold is closed, keeps the original a
     INFO(p.transpose());
     CHECK(found);
   }
-  // Each new vertex lies on its edge where the chord crosses the plane: its sphere point is the
-  // normalized mix of the edge's sphere points with the position's barycentric (gnomonic map).
+  // Domain points: four at the -z pole (the square's corners), two on the fold, one elsewhere
+  // (the fold's ends included).
   CHECK(octahedral_copies(Eigen::Vector3d(0, 0, -1)).size() == 4);
   CHECK(octahedral_copies(Eigen::Vector3d(0, 0.5, -0.5).normalized()).size() == 2);
   CHECK(octahedral_copies(Eigen::Vector3d(0, 0.5, 0.5).normalized()).size() == 1);

@@ -281,33 +281,42 @@ Result<DracoPrimitive> encode_draco_primitive(const GltfMesh& mesh, const DracoE
     dm.AddFace(face);
   }
 
-  draco::Encoder encoder;
-  encoder.SetAttributeExplicitQuantization(draco::GeometryAttribute::POSITION, q.position_bits, 3,
-                                           q.position_origin.data(), q.position_range);
-  if (mesh.N.rows() > 0) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, q.normal_bits);
-  if (mesh.UV.rows() > 0) {
-    encoder.SetAttributeExplicitQuantization(draco::GeometryAttribute::TEX_COORD, q.texcoord_bits, 2,
-                                             q.texcoord_origin.data(), q.texcoord_range);
-    // Texel-lattice coordinates: parallelogram prediction (the fourth corner of the
-    // parallelogram over the neighbouring triangle) is exact on a grid, so they cost almost
-    // nothing. Draco's default texture-coordinate predictor extrapolates from the 3D triangle
-    // shapes and spent about a third of a geometry-image LOD's bytes on them (bunny,
-    // 257 x 257: 310 KB -> 225 KB).
-    if (mesh.texture_size > 0 && !options.sequential) {
-      const draco::Status ps =
-          encoder.SetAttributePredictionScheme(draco::GeometryAttribute::TEX_COORD, draco::MESH_PREDICTION_PARALLELOGRAM);
-      if (!ps.ok()) return Status(ErrorCode::Internal, "Draco rejected the prediction scheme: " + ps.error_msg_string());
+  auto encode = [&](bool texcoord_parallelogram) -> Result<std::string> {
+    draco::Encoder encoder;
+    encoder.SetAttributeExplicitQuantization(draco::GeometryAttribute::POSITION, q.position_bits, 3,
+                                             q.position_origin.data(), q.position_range);
+    if (mesh.N.rows() > 0) encoder.SetAttributeQuantization(draco::GeometryAttribute::NORMAL, q.normal_bits);
+    if (mesh.UV.rows() > 0) {
+      encoder.SetAttributeExplicitQuantization(draco::GeometryAttribute::TEX_COORD, q.texcoord_bits, 2,
+                                               q.texcoord_origin.data(), q.texcoord_range);
+      // Texel-lattice coordinates: parallelogram prediction (the fourth corner of the
+      // parallelogram over the neighbouring triangle) is exact on a grid, so they cost almost
+      // nothing. Draco's default texture-coordinate predictor extrapolates from the 3D triangle
+      // shapes and spent about a third of a geometry-image LOD's bytes on them (bunny,
+      // 257 x 257: 310 KB -> 225 KB).
+      if (texcoord_parallelogram) {
+        const draco::Status ps =
+            encoder.SetAttributePredictionScheme(draco::GeometryAttribute::TEX_COORD, draco::MESH_PREDICTION_PARALLELOGRAM);
+        if (!ps.ok()) return Status(ErrorCode::Internal, "Draco rejected the prediction scheme: " + ps.error_msg_string());
+      }
     }
+    const int speed = 10 - options.compression_level;
+    encoder.SetSpeedOptions(speed, speed);
+    encoder.SetEncodingMethod(options.sequential ? draco::MESH_SEQUENTIAL_ENCODING : draco::MESH_EDGEBREAKER_ENCODING);
+    draco::EncoderBuffer buffer;
+    const draco::Status st = encoder.EncodeMeshToBuffer(dm, &buffer);
+    if (!st.ok()) return Status(ErrorCode::Internal, "Draco encoding failed: " + st.error_msg_string());
+    return std::string(buffer.data(), buffer.size());
+  };
+  const bool lattice = mesh.UV.rows() > 0 && mesh.texture_size > 0 && !options.sequential;
+  SPHEREKIT_ASSIGN_OR_RETURN(std::string bytes, encode(lattice));
+  if (options.smallest_texcoord_prediction && mesh.UV.rows() > 0 && !lattice && !options.sequential) {
+    SPHEREKIT_ASSIGN_OR_RETURN(std::string other, encode(true));
+    if (other.size() < bytes.size()) bytes = std::move(other);
   }
-  const int speed = 10 - options.compression_level;
-  encoder.SetSpeedOptions(speed, speed);
-  encoder.SetEncodingMethod(options.sequential ? draco::MESH_SEQUENTIAL_ENCODING : draco::MESH_EDGEBREAKER_ENCODING);
-  draco::EncoderBuffer buffer;
-  const draco::Status st = encoder.EncodeMeshToBuffer(dm, &buffer);
-  if (!st.ok()) return Status(ErrorCode::Internal, "Draco encoding failed: " + st.error_msg_string());
 
   DracoPrimitive out;
-  out.bytes.assign(buffer.data(), buffer.size());
+  out.bytes = std::move(bytes);
   auto decoded = decode_draco_primitive(out.bytes);
   if (!decoded.ok())
     return Status(ErrorCode::Internal, "Draco cannot decode its own output: " + decoded.status().message());

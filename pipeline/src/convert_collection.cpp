@@ -149,7 +149,7 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
         }
         // Adaptive levels: one simplification of every member in R^3n (adaptive_lods.h), so level
         // k has one connectivity in every member and each level is also a morph-target glTF.
-        if (o.lods > 0 && o.lod_mode == convert::LodMode::Adaptive) {
+        if (o.lods > 0 && o.lod_mode != convert::LodMode::Uniform) {  // Original: adaptive for members
           std::vector<GeometryImage> images;
           std::vector<convert::GltfLodOptions> lod_options;
           for (const ConvertedMember& c : result.members) {

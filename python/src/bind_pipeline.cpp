@@ -26,7 +26,8 @@ SphereParamOptions sphere_defaults(int effort, std::uint64_t seed, int threads) 
 convert::LodMode lod_mode(const std::string& name) {
   if (name == "uniform") return convert::LodMode::Uniform;
   if (name == "adaptive") return convert::LodMode::Adaptive;
-  throw_status(Status(ErrorCode::InvalidArgument, "lod_mode must be 'uniform' or 'adaptive', not '" + name + "'"));
+  if (name == "original") return convert::LodMode::Original;
+  throw_status(Status(ErrorCode::InvalidArgument, "lod_mode must be 'original', 'adaptive' or 'uniform', not '" + name + "'"));
 }
 
 convert::DisplacementKind displacement_kind(const std::string& name) {
@@ -51,7 +52,7 @@ pipeline::ConvertOptions convert_options(int size, int lods, const std::string& 
 
 // The convert options as keyword arguments, one spelling for both convert functions.
 #define SPHEREKIT_PY_CONVERT_ARGS                                                                       \
-  pyb::kw_only(), pyb::arg("size") = 257, pyb::arg("lods") = 0, pyb::arg("lod_mode") = "adaptive",      \
+  pyb::kw_only(), pyb::arg("size") = 257, pyb::arg("lods") = 0, pyb::arg("lod_mode") = "original",      \
       pyb::arg("cage") = 0, pyb::arg("cage_tile") = 17, pyb::arg("displacement") = "scalar",           \
       pyb::arg("psnr_samples") = pipeline::ConvertOptions{}.psnr_samples, pyb::arg("threads") = 0,     \
       pyb::arg("progress") = pyb::none()

@@ -191,13 +191,15 @@ TEST_CASE("determinism: convert writes the same EXR, remesh and glTF files twice
   INFO("param stderr: " << r.err);
   REQUIRE(r.exit_code == 0);
 
-  // convert has no --threads option: only the repeat is checked. Same input paths (the
-  // glTF provenance names them), outputs under the same names in two folders.
-  for (const char* folder : {"first", "second"}) {
+  // The repeat, and the repeat with one thread (`first` uses every core). Same input paths
+  // (the glTF provenance names them), outputs under the same names in three folders. The
+  // levels are the default `original` ones (the mesh itself simplified).
+  for (const char* folder : {"first", "second", "one_thread"}) {
     const std::string out = dir + "/" + folder;
     fs::create_directories(out);
+    const std::string threads = std::string(folder) == "one_thread" ? " --threads 1" : "";
     r = sk("convert " + q(mesh) + " " + q(map) + " -o " + q(out + "/gim.exr") + " --size 65 --lods 2 --psnr-samples 2000 --remesh " +
-               q(out + "/remesh.obj") + " --quiet",
+               q(out + "/remesh.obj") + " --quiet" + threads,
            dir);
     INFO("run " << folder << ", stderr: " << r.err);
     REQUIRE(r.exit_code == 0);
@@ -206,5 +208,9 @@ TEST_CASE("determinism: convert writes the same EXR, remesh and glTF files twice
   CHECK(names == files_in(dir + "/second"));
   CHECK(names == std::vector<std::string>{"gim.exr", "gim_lod0.glb", "gim_lod1.glb", "gim_lods.glb", "gim_normals.png",
                                            "gim_positions.png", "remesh.obj"});
-  for (const std::string& name : names) require_same_bytes(dir + "/first/" + name, dir + "/second/" + name);
+  CHECK(names == files_in(dir + "/one_thread"));
+  for (const std::string& name : names) {
+    require_same_bytes(dir + "/first/" + name, dir + "/second/" + name);
+    require_same_bytes(dir + "/first/" + name, dir + "/one_thread/" + name);
+  }
 }

@@ -85,6 +85,25 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     }
   }
 
+  // Levels simplified from the original mesh (original_lods_test): a closed blob and a mesh with
+  // holes, texture coordinates on the octahedral domain with seams at the fold.
+  {
+    GltfLodOptions original = test::lod_test_options();
+    original.mode = LodMode::Original;
+    original.position_bits_rule = PositionBitsRule::RateDistortion;
+    const TriMesh blob = test::random_blob(3, 7);
+    auto closed = build_original_gltf_lods(blob, blob.V.rowwise().normalized(), 65, original);
+    REQUIRE(closed.ok());
+    auto closed_paths = write_gltf_lods(dir + "/original", closed.value());
+    REQUIRE(closed_paths.ok());
+    files.insert(files.end(), closed_paths->levels.begin(), closed_paths->levels.end());
+    files.push_back(closed_paths->combined);
+    const test::HoledLodImages holed = test::holed_lod_images(33, 1);
+    auto open = build_original_gltf_lods(holed.mesh, holed.S, 33, original);
+    REQUIRE(open.ok());
+    write("original_holed_lods.glb", open->combined_glb);
+  }
+
   // gltf_morph_test: uncompressed, Draco sequential, from triangle meshes.
   const std::vector<GltfMesh> members = test::collection_test_meshes(17);
   auto plain = build_gltf_morph_targets(members);

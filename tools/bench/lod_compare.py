@@ -4,6 +4,7 @@
 (glb2obj.mjs decodes Draco/meshopt/quantized glTF, `spherekit eval-surface` the PSNR).
 
   python3 tools/bench/lod_compare.py SPHEREKIT NAME MESH SPHERE MESH_AS_OBJ OUTDIR [-- CONVERT_ARGS]
+  (env LOD_MODES=original,adaptive,uniform: which of our modes run)
 
 SPHERE = collection:DIR measures member NAME of the consistent collection DIR (its levels from
 `convert --collection`, adaptive: one connectivity for all members) against the peers run on
@@ -46,7 +47,12 @@ def interp(points, p):
             return math.exp(math.log(s0) * (1 - t) + math.log(s1) * t)
     return None
 
-modes = {'adaptive': ['--lod-mode', 'adaptive'] + extra, 'uniform': ['--lod-mode', 'uniform']}
+# LOD_MODES (comma-separated, default original,adaptive,uniform) picks our modes; CONVERT_ARGS
+# go to original and adaptive. A collection member has no original levels (skipped).
+all_modes = {'original': ['--lod-mode', 'original'] + extra, 'adaptive': ['--lod-mode', 'adaptive'] + extra,
+             'uniform': ['--lod-mode', 'uniform']}
+want = os.environ.get('LOD_MODES', 'original,adaptive,uniform').split(',')
+modes = {m: all_modes[m] for m in want if not (m == 'original' and sphere.startswith('collection:'))}
 ours, bits = {}, set()
 for mode, args in modes.items():
     if sphere.startswith('collection:'):

@@ -95,10 +95,12 @@ void register_convert(CLI::App& app) {
                   "points sampled per direction for the PSNR (0: skip it; default 400000)");
   cmd->add_option("--lods", args->options.lods, "also write this many glTF levels of detail (default 0: none)");
   cmd->add_option("--lod-mode", args->options.lod_mode,
-                  "glTF levels: adaptive (quadric simplification of the remesh, default; a collection's members "
-                  "share each level's connectivity) or uniform (coarser geometry images)")
+                  "glTF levels: original (quadric simplification of the mesh itself, texture coordinates into the "
+                  "geometry image, seams at the octahedral fold; single meshes), adaptive (quadric simplification of "
+                  "the remesh; a collection's members share each level's connectivity) or uniform (coarser geometry "
+                  "images)")
       ->transform(CLI::CheckedTransformer(std::map<std::string, convert::LodMode>{
-          {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}}));
+          {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}, {"original", convert::LodMode::Original}}));
   cmd->add_flag("!--no-lod-normals", args->options.lod_normals,
                 "glTF levels without NORMAL (a viewer derives them from the triangles, as for gltfpack -cc "
                 "output)");

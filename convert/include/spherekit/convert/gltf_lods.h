@@ -58,6 +58,10 @@ enum class LodMode {
   /// Level k = the finest image's remesh simplified by quadric edge collapses to a quarter of
   /// the previous level's vertices (adaptive_lods.h); the coarser images, if given, are unused.
   Adaptive,
+  /// Single meshes: level k = the ORIGINAL mesh, cut along the octahedral fold and simplified
+  /// by quadric edge collapses to V / 4^k vertices, TEXCOORD_0 = each vertex's octahedral
+  /// domain point in the finest image (original_lods.h; build_original_gltf_lods).
+  Original,
 };
 
 /// How each level's position bits are chosen.
@@ -99,6 +103,10 @@ struct GltfLodOptions {
   int coarse_position_bits = 0;
   PositionBitsRule position_bits_rule = PositionBitsRule::RateDistortion;
   int min_position_bits_rd = 6;  ///< RateDistortion: never fewer bits than this
+  /// Original: texture-coordinate bits ceil(log2((T-1) / (2 err))), err this value: a grid
+  /// step of about 2 err texels of the T x T geometry image, so a coordinate moves by about
+  /// err texels at most (0.5 and T = 257: 8 bits, at most 0.502 texel).
+  double texcoord_max_error_texels = 0.5;
   std::string name = "mesh";    ///< node and mesh names: NAME_LOD0, NAME_LOD1, ...
   GltfProvenance provenance;
   // Effort
@@ -137,6 +145,16 @@ struct GltfLods {
 /// and InvalidArgument if a level has the wrong size.
 [[nodiscard]] Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images,
                                                const GltfLodOptions& options = {}, const ProgressFn& progress = {});
+
+/// Levels of detail of a single mesh by simplification of the mesh itself (LodMode::Original,
+/// original_lods.h): `S` its sphere map, `texture_size` the finest geometry image's side, which
+/// the texture coordinates index. Each level's position bits by rate and distortion against its
+/// RMS distance to `mesh` (reference_rms_error is not used: level 0 is the mesh); texture
+/// coordinate bits from texcoord_max_error_texels. options.mode is recorded as Original.
+/// Errors: those of original_lod_meshes and build_gltf_lods.
+[[nodiscard]] Result<GltfLods> build_original_gltf_lods(const TriMesh& mesh, const RowMat3d& S, int texture_size,
+                                                        const GltfLodOptions& options = {},
+                                                        const ProgressFn& progress = {});
 
 /// The levels of detail of a consistent collection's members (one geometry image each, one
 /// size), every member's levels with the same connectivity: Adaptive simplifies all members at

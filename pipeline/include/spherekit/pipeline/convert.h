@@ -36,9 +36,11 @@ struct ConvertOptions {
   TexelPositions positions = TexelPositions::Fit;
   int psnr_samples = RemeshErrorOptions{}.samples;  ///< per direction; 0: no PSNR
   int lods = 0;                                     ///< glTF levels of detail (0: none)
-  /// How the levels are made (gltf_lods.h). Adaptive by default: at equal PSNR its files are
-  /// 1.5-5x smaller than the uniform levels' on every mesh measured (README, issue 22).
-  convert::LodMode lod_mode = convert::LodMode::Adaptive;
+  /// How the levels are made (gltf_lods.h). Original by default: a single mesh's levels are
+  /// the mesh itself simplified (original_lods.h), at equal PSNR smaller than the adaptive
+  /// levels on every mesh measured (README, issue 22); a collection's members take the adaptive
+  /// levels (one connectivity for all members) under Original as under Adaptive.
+  convert::LodMode lod_mode = convert::LodMode::Original;
   bool lod_normals = true;  ///< glTF levels carry NORMAL (GltfLodOptions::normals; single meshes)
   int lod_coarse_position_bits = 0;  ///< GltfLodOptions::coarse_position_bits (adaptive single meshes)
   /// GltfLodOptions::position_bits_rule: each level's bits by rate and distortion (default) or

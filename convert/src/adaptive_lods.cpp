@@ -158,29 +158,18 @@ Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector
   SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, F, pm_options, progress));
 
   // Replay the collapses up to each level's vertex count.
-  std::vector<int> parent(static_cast<std::size_t>(nv));
-  for (int v = 0; v < nv; ++v) parent[static_cast<std::size_t>(v)] = v;
-  auto find = [&parent](int v) {
-    while (parent[static_cast<std::size_t>(v)] != v) v = parent[static_cast<std::size_t>(v)];
-    return v;
-  };
-  std::vector<char> face_alive(static_cast<std::size_t>(F.rows()), 1);
-  std::size_t done = 0;
+  CollapseReplay replay(pm);
   std::vector<std::vector<GltfMesh>> out;
   for (int k = 0; k < options.levels; ++k) {
     const std::size_t want = static_cast<std::size_t>(std::max(0, nv - targets[static_cast<std::size_t>(k)]));
-    for (; done < want && done < pm.collapses.size(); ++done) {
-      const HalfEdgeCollapse& c = pm.collapses[done];
-      parent[static_cast<std::size_t>(c.vt)] = c.vs;
-      for (int f : c.removed) face_alive[static_cast<std::size_t>(f)] = 0;
-    }
+    replay.advance_to(want);
     // Faces in input order, corners as texels; points = texels used, ascending.
     std::vector<std::array<int, 3>> faces;
     std::vector<char> used(welded.size(), 0);
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      if (!face_alive[static_cast<std::size_t>(f)]) continue;
+      if (!replay.alive(static_cast<int>(f))) continue;
       if (!hole_faces.empty() && hole_faces[static_cast<std::size_t>(f)]) continue;
-      const std::array<int, 3> v{find(F(f, 0)), find(F(f, 1)), find(F(f, 2))};
+      const std::array<int, 3> v{replay.find(F(f, 0)), replay.find(F(f, 1)), replay.find(F(f, 2))};
       const std::array<int, 3> t = face_texels(v, copies, n);
       for (int x : t) used[static_cast<std::size_t>(x)] = 1;
       faces.push_back(t);

@@ -235,28 +235,17 @@ Result<std::vector<GltfMesh>> original_lod_meshes(const TriMesh& mesh, const Row
   std::vector<std::vector<Eigen::Vector2d>> copies(static_cast<std::size_t>(nv));
   for (int v = 0; v < nv; ++v) copies[static_cast<std::size_t>(v)] = octahedral_copies(cut.S.row(v).transpose());
 
-  std::vector<int> parent(static_cast<std::size_t>(nv));
-  for (int v = 0; v < nv; ++v) parent[static_cast<std::size_t>(v)] = v;
-  auto find = [&parent](int v) {
-    while (parent[static_cast<std::size_t>(v)] != v) v = parent[static_cast<std::size_t>(v)];
-    return v;
-  };
-  std::vector<char> face_alive(static_cast<std::size_t>(F.rows()), 1);
-  std::size_t done = 0;
+  CollapseReplay replay(pm);
   std::vector<GltfMesh> out;
   for (int k = 0; k < options.levels; ++k) {
     const std::size_t want = static_cast<std::size_t>(std::max(0, nv - targets[static_cast<std::size_t>(k)]));
-    for (; done < want && done < pm.collapses.size(); ++done) {
-      const HalfEdgeCollapse& c = pm.collapses[done];
-      parent[static_cast<std::size_t>(c.vt)] = c.vs;
-      for (int f : c.removed) face_alive[static_cast<std::size_t>(f)] = 0;
-    }
+    replay.advance_to(want);
     // Per face, the corners' copies making its texture triangle smallest (perimeter; ties:
     // the first in copy order).
     std::vector<std::array<std::pair<int, int>, 3>> faces;  // (vertex, copy) per corner
     for (Eigen::Index f = 0; f < F.rows(); ++f) {
-      if (!face_alive[static_cast<std::size_t>(f)] || cut.hole_faces[static_cast<std::size_t>(f)]) continue;
-      const std::array<int, 3> v{find(F(f, 0)), find(F(f, 1)), find(F(f, 2))};
+      if (!replay.alive(static_cast<int>(f)) || cut.hole_faces[static_cast<std::size_t>(f)]) continue;
+      const std::array<int, 3> v{replay.find(F(f, 0)), replay.find(F(f, 1)), replay.find(F(f, 2))};
       const auto& c0 = copies[static_cast<std::size_t>(v[0])];
       const auto& c1 = copies[static_cast<std::size_t>(v[1])];
       const auto& c2 = copies[static_cast<std::size_t>(v[2])];

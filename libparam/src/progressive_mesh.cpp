@@ -422,4 +422,22 @@ Result<ProgressiveMesh> build_progressive_mesh(const RowMatXd& P, const RowMat3i
   return pm;
 }
 
+CollapseReplay::CollapseReplay(const ProgressiveMesh& pm)
+    : pm_(&pm), parent_(static_cast<std::size_t>(pm.num_vertices)), alive_(static_cast<std::size_t>(pm.F.rows()), 1) {
+  for (int v = 0; v < pm.num_vertices; ++v) parent_[static_cast<std::size_t>(v)] = v;
+}
+
+void CollapseReplay::advance_to(std::size_t count) {
+  for (; done_ < count && done_ < pm_->collapses.size(); ++done_) {
+    const HalfEdgeCollapse& c = pm_->collapses[done_];
+    parent_[static_cast<std::size_t>(c.vt)] = c.vs;
+    for (int f : c.removed) alive_[static_cast<std::size_t>(f)] = 0;
+  }
+}
+
+int CollapseReplay::find(int v) const {
+  while (parent_[static_cast<std::size_t>(v)] != v) v = parent_[static_cast<std::size_t>(v)];
+  return v;
+}
+
 }  // namespace spherekit

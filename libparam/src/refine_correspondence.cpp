@@ -307,14 +307,7 @@ class MemberFit {
       const int u = t_.F(f, c);
       p[c] = u == v ? y : Vec3(Y_.row(u).transpose());
     }
-    const Eigen::Matrix2d& Gi = rest_inv_[static_cast<size_t>(f)];
-    const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
-    Eigen::Matrix2d Gy;
-    Gy << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
-    const double d = Gy.determinant() * rest_det_inv_[static_cast<size_t>(f)];
-    if (!(d > 0)) return std::numeric_limits<double>::infinity();
-    const double t = (Gi * Gy).trace();
-    return rest_area_[static_cast<size_t>(f)] * (t + t / d);
+    return rest_area_[static_cast<size_t>(f)] * sd_density(f, p);
   }
   void init_rest() {
     const Eigen::Index nfaces = t_.F.rows();

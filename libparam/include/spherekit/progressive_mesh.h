@@ -75,6 +75,24 @@ struct ProgressiveMeshOptions {
 /// of 3 columns is one model, used for fold-over checks).
 /// Errors: InvalidInput (sizes), SolverFailed (could not reach the target, e.g. not genus 0),
 /// Cancelled.
+/// The collapses of a progressive mesh replayed forwards, as levels of detail read them:
+/// which vertex each input vertex has become and which input faces are still alive.
+class CollapseReplay {
+ public:
+  explicit CollapseReplay(const ProgressiveMesh& pm);
+  /// Applies the collapses up to (not including) `count` (at most all of them).
+  void advance_to(std::size_t count);
+  /// The vertex that input vertex v has become.
+  int find(int v) const;
+  bool alive(int face) const { return alive_[static_cast<std::size_t>(face)] != 0; }
+
+ private:
+  const ProgressiveMesh* pm_;
+  std::vector<int> parent_;
+  std::vector<char> alive_;
+  std::size_t done_ = 0;
+};
+
 Result<ProgressiveMesh> build_progressive_mesh(const RowMatXd& P, const RowMat3i& F,
                                                const ProgressiveMeshOptions& options = {},
                                                const ProgressFn& progress = {});

@@ -11,6 +11,7 @@
 #include <limits>
 #include <string>
 
+#include "lod_constraints.h"
 #include "spherekit/progressive_mesh.h"
 
 namespace spherekit::convert {
@@ -64,24 +65,6 @@ std::array<int, 3> face_texels(const std::array<int, 3>& v, const std::vector<st
   return best;
 }
 
-// The rim between the faces spanning holes and the others, as simplifier path edges (welded
-// ids): the edges whose two faces are on different sides. Merged into `edges`, sorted, unique.
-void add_rim_edges(const RowMat3i& F, const std::vector<std::uint8_t>& hole_faces,
-                   std::vector<std::array<int, 2>>& edges) {
-  std::vector<std::array<int, 3>> half;  // (min, max, side) per face edge
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = F(f, k), b = F(f, (k + 1) % 3);
-      half.push_back({std::min(a, b), std::max(a, b), hole_faces[static_cast<std::size_t>(f)] ? 1 : 0});
-    }
-  std::sort(half.begin(), half.end());
-  for (std::size_t i = 0; i + 1 < half.size(); ++i)
-    if (half[i][0] == half[i + 1][0] && half[i][1] == half[i + 1][1] && half[i][2] != half[i + 1][2])
-      edges.push_back({half[i][0], half[i][1]});
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-}
-
 Status check_members(const std::vector<GeometryImage>& members, const AdaptiveLodOptions& options) {
   if (members.empty()) return Status(ErrorCode::InvalidArgument, "adaptive levels of detail: no member");
   const int n = members[0].size;
@@ -133,7 +116,7 @@ Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector
   std::vector<std::uint8_t> hole_faces;
   if (options.drop_hole_faces) hole_faces = geometry_image_hole_faces(members[0]);
   if (!hole_faces.empty()) {
-    add_rim_edges(F, hole_faces, pm_options.constraint_edges);
+    detail::add_rim_edges(F, hole_faces, pm_options.constraint_edges);
     // The faces spanning holes are left out, so their shape must not steer the surface's.
     pm_options.face_weights.assign(hole_faces.size(), 1.0);
     for (std::size_t f = 0; f < hole_faces.size(); ++f)

@@ -3,6 +3,8 @@
 // 1996 (half-edge collapses); Praun & Hoppe 2003 (the octahedral domain and its fold).
 #include "spherekit/convert/original_lods.h"
 
+#include "lod_constraints.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -104,7 +106,6 @@ struct Cutter {
 // between hole faces and the others, as sorted unique (min, max) pairs.
 std::vector<std::array<int, 2>> constraint_edges(const FoldCutMesh& cut) {
   std::vector<std::array<int, 2>> edges;
-  std::vector<std::array<int, 3>> half;
   const RowMat3i& F = cut.mesh.F;
   const RowMat3d& S = cut.S;
   for (Eigen::Index f = 0; f < F.rows(); ++f)
@@ -113,14 +114,8 @@ std::vector<std::array<int, 2>> constraint_edges(const FoldCutMesh& cut) {
       const bool on_x = S(a, 0) == 0 && S(b, 0) == 0, on_y = S(a, 1) == 0 && S(b, 1) == 0;
       const bool lower = S(a, 2) <= 0 && S(b, 2) <= 0 && !(S(a, 2) == 0 && S(b, 2) == 0);
       if ((on_x || on_y) && lower) edges.push_back({std::min(a, b), std::max(a, b)});
-      half.push_back({std::min(a, b), std::max(a, b), cut.hole_faces[static_cast<std::size_t>(f)] ? 1 : 0});
     }
-  std::sort(half.begin(), half.end());
-  for (std::size_t i = 0; i + 1 < half.size(); ++i)
-    if (half[i][0] == half[i + 1][0] && half[i][1] == half[i + 1][1] && half[i][2] != half[i + 1][2])
-      edges.push_back({half[i][0], half[i][1]});
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  detail::add_rim_edges(F, cut.hole_faces, edges);  // sorts and removes duplicates
   return edges;
 }
 

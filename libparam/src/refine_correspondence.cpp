@@ -9,7 +9,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <memory>
 #include <utility>
 
 #include <Eigen/SVD>
@@ -33,10 +32,31 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The template's rigidity metric: symmetric spoke weights (cotangent, clamped to a small
-// positive floor so that the system stays positive definite on poor triangulations), the
-// spokes as CSR, and lumped vertex areas.
+// Faces around each vertex of a mesh (CSR).
+struct VertexFaces {
+  std::vector<int> start, face;
+  explicit VertexFaces(const TriMesh& m) {
+    const int nv = static_cast<int>(m.V.rows());
+    start.assign(static_cast<size_t>(nv) + 1, 0);
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) ++start[static_cast<size_t>(m.F(f, c)) + 1];
+    for (int v = 0; v < nv; ++v) start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
+    face.resize(static_cast<size_t>(start.back()));
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) face[static_cast<size_t>(fill[static_cast<size_t>(m.F(f, c))]++)] = static_cast<int>(f);
+  }
+};
+
+// What the fit needs of the template, made once per call: symmetric spoke weights
+// (cotangent, clamped to a small positive floor so that the system stays positive definite
+// on poor triangulations), the spokes as CSR, lumped vertex areas, the faces around each
+// vertex, and each face's rest metric (for the symmetric Dirichlet shape check).
 struct TemplateMetric {
+  explicit TemplateMetric(const TriMesh& m) : faces(m) {}
+  VertexFaces faces;
+  std::vector<Eigen::Matrix2d> rest_inv;  // inverse Gram matrix of the face's edge vectors
+  std::vector<double> rest_det_inv, rest_area;
   std::vector<int> start;   // CSR over vertices
   std::vector<int> nbr;
   std::vector<double> w;
@@ -49,7 +69,7 @@ struct TemplateMetric {
 TemplateMetric template_metric(const TriMesh& m) {
   const int nv = static_cast<int>(m.V.rows());
   std::map<std::pair<int, int>, double> cot;
-  TemplateMetric t;
+  TemplateMetric t(m);
   t.area.assign(static_cast<size_t>(nv), 0.0);
   for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
     const Vec3 p[3] = {m.V.row(m.F(f, 0)).transpose(), m.V.row(m.F(f, 1)).transpose(),
@@ -89,24 +109,22 @@ TemplateMetric template_metric(const TriMesh& m) {
   }
   t.mean_diag = nv > 0 ? diag / nv : 1.0;
   t.mean_area = nv > 0 ? t.total_area / nv : 1.0;
+  const Eigen::Index nfaces = m.F.rows();
+  t.rest_inv.resize(static_cast<size_t>(nfaces));
+  t.rest_det_inv.resize(static_cast<size_t>(nfaces));
+  t.rest_area.resize(static_cast<size_t>(nfaces));
+  for (Eigen::Index f = 0; f < nfaces; ++f) {
+    const Vec3 a = m.V.row(m.F(f, 0)).transpose();
+    const Vec3 e1 = Vec3(m.V.row(m.F(f, 1)).transpose()) - a, e2 = Vec3(m.V.row(m.F(f, 2)).transpose()) - a;
+    Eigen::Matrix2d G;
+    G << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+    const double det = G.determinant();
+    t.rest_area[static_cast<size_t>(f)] = 0.5 * std::sqrt(std::max(det, 0.0));
+    t.rest_inv[static_cast<size_t>(f)] = det > 0 ? Eigen::Matrix2d(G.inverse()) : Eigen::Matrix2d::Zero();
+    t.rest_det_inv[static_cast<size_t>(f)] = det > 0 ? 1.0 / det : 0.0;
+  }
   return t;
 }
-
-// Faces around each vertex of a mesh (CSR).
-struct VertexFaces {
-  std::vector<int> start, face;
-  explicit VertexFaces(const TriMesh& m) {
-    const int nv = static_cast<int>(m.V.rows());
-    start.assign(static_cast<size_t>(nv) + 1, 0);
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-      for (int c = 0; c < 3; ++c) ++start[static_cast<size_t>(m.F(f, c)) + 1];
-    for (int v = 0; v < nv; ++v) start[static_cast<size_t>(v) + 1] += start[static_cast<size_t>(v)];
-    face.resize(static_cast<size_t>(start.back()));
-    std::vector<int> fill(start.begin(), start.end() - 1);
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-      for (int c = 0; c < 3; ++c) face[static_cast<size_t>(fill[static_cast<size_t>(m.F(f, c))]++)] = static_cast<int>(f);
-  }
-};
 
 // Walks on the surface from `p` to a point locally nearest to `target`: moves to the
 // nearest point of the faces around the current face's corners while that is nearer.
@@ -148,8 +166,9 @@ Vec3 sphere_point(const TriMesh& m, const RowMat3d& S, const SurfacePoint& p) {
 class MemberFit {
  public:
   MemberFit(const TriMesh& tmpl, const RowMat3d& St, const TemplateMetric& metric, const std::vector<int>& tfeat,
-            const TriMesh& mesh, const RowMat3d& Si, const std::vector<int>& feat, const RefineCorrespondenceOptions& o)
-      : t_(tmpl), St_(St), metric_(metric), m_(mesh), Si_(Si), vf_(mesh), o_(o) {
+            const TriMesh& mesh, const VertexFaces& mesh_faces, const RowMat3d& Si, const std::vector<int>& feat,
+            const RefineCorrespondenceOptions& o)
+      : t_(tmpl), St_(St), metric_(metric), m_(mesh), Si_(Si), vf_(mesh_faces), o_(o) {
     const int nv = static_cast<int>(t_.V.rows());
     q_.resize(static_cast<size_t>(nv));
     sp_.resize(static_cast<size_t>(nv));
@@ -168,9 +187,6 @@ class MemberFit {
       fixed_[static_cast<size_t>(v)] = 1;
     }
     for (int v = 0; v < nv; ++v) Y_.row(v) = surface_position(m_, sp_[static_cast<size_t>(v)]).transpose();
-    // Template faces around each template vertex, for the validity check of a move.
-    tvf_ = std::make_unique<VertexFaces>(t_);
-    init_rest();
   }
 
   // Runs the rounds (q() then holds one unit vector per template vertex).
@@ -188,7 +204,6 @@ class MemberFit {
       if (!fixed_[static_cast<size_t>(v)]) index[static_cast<size_t>(v)] = nf++;
     const double mu = o_.damping * metric_.mean_diag / metric_.mean_area;
     std::vector<Eigen::Matrix3d> R(static_cast<size_t>(nv));
-    rotations(R);
     *e_before = sd_total();
     std::vector<Eigen::Matrix<double, 3, 2>> T(static_cast<size_t>(nv));
     std::vector<Eigen::Triplet<double>> trip;
@@ -196,7 +211,7 @@ class MemberFit {
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
     for (int it = 0; it < o_.iterations && nf > 0; ++it) {
       if (!keep_going()) return Status(ErrorCode::Cancelled, "cancelled");
-      if (it > 0) rotations(R);
+      rotations(R);
       for (int v = 0; v < nv; ++v) T[static_cast<size_t>(v)] = tangent_basis(sp_[static_cast<size_t>(v)].face);
       trip.clear();
       g.setZero();
@@ -307,29 +322,13 @@ class MemberFit {
       const int u = t_.F(f, c);
       p[c] = u == v ? y : Vec3(Y_.row(u).transpose());
     }
-    return rest_area_[static_cast<size_t>(f)] * sd_density(f, p);
-  }
-  void init_rest() {
-    const Eigen::Index nfaces = t_.F.rows();
-    rest_inv_.resize(static_cast<size_t>(nfaces));
-    rest_det_inv_.resize(static_cast<size_t>(nfaces));
-    rest_area_.resize(static_cast<size_t>(nfaces));
-    for (Eigen::Index f = 0; f < nfaces; ++f) {
-      const Vec3 a = t_.V.row(t_.F(f, 0)).transpose();
-      const Vec3 e1 = Vec3(t_.V.row(t_.F(f, 1)).transpose()) - a, e2 = Vec3(t_.V.row(t_.F(f, 2)).transpose()) - a;
-      Eigen::Matrix2d G;
-      G << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
-      const double det = G.determinant();
-      rest_area_[static_cast<size_t>(f)] = 0.5 * std::sqrt(std::max(det, 0.0));
-      rest_inv_[static_cast<size_t>(f)] = det > 0 ? Eigen::Matrix2d(G.inverse()) : Eigen::Matrix2d::Zero();
-      rest_det_inv_[static_cast<size_t>(f)] = det > 0 ? 1.0 / det : 0.0;
-    }
+    return metric_.rest_area[static_cast<size_t>(f)] * sd_density(f, p);
   }
   double sd_total() const {
     double e = 0, a = 0;
     for (Eigen::Index f = 0; f < t_.F.rows(); ++f) {
       e += sd_face(static_cast<int>(f), -1, Vec3::Zero());
-      a += rest_area_[static_cast<size_t>(f)];
+      a += metric_.rest_area[static_cast<size_t>(f)];
     }
     return a > 0 ? e / a : 0.0;
   }
@@ -337,11 +336,11 @@ class MemberFit {
   const std::vector<Vec3>& q() const { return q_; }
 
  private:
-  // Best rotation per template vertex for the current Y; returns the energy / area.
-  double rotations(std::vector<Eigen::Matrix3d>& R) const {
+  // Best rotation per template vertex for the current Y (the ARAP local step).
+  void rotations(std::vector<Eigen::Matrix3d>& R) const {
     const int nv = static_cast<int>(t_.V.rows());
-    double e = 0;
     for (int v = 0; v < nv; ++v) {
+      // Kabsch on the weighted spokes, C = sum of w (x_v - x_j)(y_v - y_j)^T: R = V U^T.
       Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
       const Vec3 xv = t_.V.row(v).transpose(), yv = Y_.row(v).transpose();
       for (int k = metric_.start[static_cast<size_t>(v)]; k < metric_.start[static_cast<size_t>(v) + 1]; ++k) {
@@ -356,13 +355,7 @@ class MemberFit {
         Rv = svd.matrixV() * U.transpose();
       }
       R[static_cast<size_t>(v)] = Rv;
-      for (int k = metric_.start[static_cast<size_t>(v)]; k < metric_.start[static_cast<size_t>(v) + 1]; ++k) {
-        const int j = metric_.nbr[static_cast<size_t>(k)];
-        e += metric_.w[static_cast<size_t>(k)] *
-             ((yv - Y_.row(j).transpose()) - Rv * (xv - t_.V.row(j).transpose())).squaredNorm();
-      }
     }
-    return metric_.total_area > 0 ? e / metric_.total_area : 0.0;
   }
 
   // A face's shape after a joint move is refused when its symmetric Dirichlet density
@@ -370,11 +363,11 @@ class MemberFit {
   // collapse; a nearly collapsed face makes the composed map nearly singular there).
   static constexpr double kShapeCap = 32;
   double sd_density(int f, const Vec3* p) const {
-    const Eigen::Matrix2d& Gi = rest_inv_[static_cast<size_t>(f)];
+    const Eigen::Matrix2d& Gi = metric_.rest_inv[static_cast<size_t>(f)];
     const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
     Eigen::Matrix2d Gy;
     Gy << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
-    const double d = Gy.determinant() * rest_det_inv_[static_cast<size_t>(f)];
+    const double d = Gy.determinant() * metric_.rest_det_inv[static_cast<size_t>(f)];
     if (!(d > 0)) return std::numeric_limits<double>::infinity();
     const double t = (Gi * Gy).trace();
     return t + t / d;
@@ -390,8 +383,8 @@ class MemberFit {
     return a > kShapeCap && a > sd_density(f, before);
   }
   bool shape_ok_at(int v, const Vec3& y) const {
-    for (int k = tvf_->start[static_cast<size_t>(v)]; k < tvf_->start[static_cast<size_t>(v) + 1]; ++k) {
-      const int f = tvf_->face[static_cast<size_t>(k)];
+    for (int k = metric_.faces.start[static_cast<size_t>(v)]; k < metric_.faces.start[static_cast<size_t>(v) + 1]; ++k) {
+      const int f = metric_.faces.face[static_cast<size_t>(k)];
       Vec3 before[3], after[3];
       for (int c = 0; c < 3; ++c) {
         const int u = t_.F(f, c);
@@ -422,8 +415,8 @@ class MemberFit {
 
   // Every template face around v stays positively oriented with v at qc (exact predicate).
   bool valid_at(int v, const Vec3& qc) const {
-    for (int k = tvf_->start[static_cast<size_t>(v)]; k < tvf_->start[static_cast<size_t>(v) + 1]; ++k) {
-      const int f = tvf_->face[static_cast<size_t>(k)];
+    for (int k = metric_.faces.start[static_cast<size_t>(v)]; k < metric_.faces.start[static_cast<size_t>(v) + 1]; ++k) {
+      const int f = metric_.faces.face[static_cast<size_t>(k)];
       Vec3 p[3];
       for (int c = 0; c < 3; ++c) {
         const int u = t_.F(f, c);
@@ -439,15 +432,12 @@ class MemberFit {
   const TemplateMetric& metric_;
   const TriMesh& m_;
   const RowMat3d& Si_;
-  VertexFaces vf_;
-  std::unique_ptr<VertexFaces> tvf_;
+  const VertexFaces& vf_;
   const RefineCorrespondenceOptions& o_;
   std::vector<Vec3> q_;
   std::vector<SurfacePoint> sp_;
   RowMat3d Y_;
   std::vector<char> fixed_;
-  std::vector<Eigen::Matrix2d> rest_inv_;
-  std::vector<double> rest_det_inv_, rest_area_;
 };
 
 // Member i's map composed with psi^-1, where psi sends the template's sphere points St to
@@ -479,8 +469,9 @@ std::string format_fixed(double x, int digits) {
   return buf;
 }
 
-// `count` well-spread vertices of the mesh (farthest-point samples by straight distance,
-// starting from the features, which are not returned), ascending.
+// Up to `count` well-spread vertices of the mesh in farthest-point order (straight distance,
+// starting from the features, which are not returned): any prefix is itself the farthest-
+// point sample of its size.
 std::vector<int> surface_samples(const TriMesh& m, const std::vector<int>& feat, int count) {
   const Eigen::Index nv = m.V.rows();
   std::vector<double> d(static_cast<size_t>(nv), std::numeric_limits<double>::infinity());
@@ -496,7 +487,6 @@ std::vector<int> surface_samples(const TriMesh& m, const std::vector<int>& feat,
     out.push_back(next);
     take(next);
   }
-  std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -548,9 +538,11 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
         SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics m0, evaluate_sphere_map(mi, cur));
         rep.efficiency_before = rep.efficiency_after = m0.efficiency;
         const double bar = std::min(m0.efficiency, template_efficiency);
+        const VertexFaces mi_faces(mi);
+        const std::vector<int> spread = surface_samples(mi, fi, options.samples);
         int samples = options.samples;
         for (int round = 0; round < options.rounds; ++round) {
-          MemberFit fit(tmpl, St, metric, features[static_cast<size_t>(t)], mi, cur, fi, options);
+          MemberFit fit(tmpl, St, metric, features[static_cast<size_t>(t)], mi, mi_faces, cur, fi, options);
           double e0 = 0, e1 = 0;
           SPHEREKIT_RETURN_IF_ERROR(fit.run(keep_going, &e0, &e1));
           if (round == 0) rep.energy_before = rep.energy_after = e0;
@@ -567,7 +559,8 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           Status st;
           RowMat3d S;
           for (; samples >= kMinSamples; samples /= 2) {
-            const std::vector<int> W = surface_samples(mi, fi, samples);
+            std::vector<int> W(spread.begin(), spread.begin() + std::min<std::ptrdiff_t>(samples, std::ssize(spread)));
+            std::sort(W.begin(), W.end());
             std::vector<int> fv(fi);
             std::vector<Vec3> targets;
             for (int v : fv) targets.push_back(cur.row(v).transpose());

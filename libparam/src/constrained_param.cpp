@@ -17,6 +17,7 @@
 #include "detail/feature_warp.h"
 #include "detail/path_network.h"
 #include "detail/rotation.h"
+#include "detail/kernel_point.h"
 #include "detail/sphere_embedding.h"
 #include "detail/stage_util.h"
 #include "detail/untangle_patch.h"
@@ -46,77 +47,6 @@ std::string options_digest(const ConstrainedParamOptions& o) {
 
 double angle_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
-// Final optimization of a complete mesh whose map is already valid, features fixed: the
-// coarse-to-fine machinery on a progressive mesh without collapses runs just its final pass.
-Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector<double>& face_weight,
-                         const std::vector<double>& shape_weight, const std::vector<char>& fixed,
-                         const detail::OptimizerSettings& settings, const ProgressFn& progress, RowMat3d* S) {
-  ProgressiveMesh pm;
-  pm.num_vertices = static_cast<int>(P.rows());
-  pm.F = F;
-  for (int v = 0; v < pm.num_vertices; ++v) pm.base_vertices.push_back(v);
-  for (int f = 0; f < F.rows(); ++f) pm.base_faces.push_back(f);
-  detail::EmbedInput in;
-  in.P = &P;
-  in.pm = &pm;
-  in.face_weight = face_weight;
-  in.face_shape_weight = shape_weight;
-  in.base_positions = *S;
-  in.fixed = fixed;
-  return detail::embed_coarse_to_fine(in, settings, progress, S, nullptr);
-}
-
-// Spherical Chebyshev centre of v's kernel (maximize min over ring faces of n_f . x, with
-// n_f = S_a x S_b / |S_a x S_b| for ring face (v, a, b)) by projected subgradient ascent; true
-// if the point found makes every ring face positive by the exact predicate. When the kernel
-// is empty and `compromise` is given, it receives the best max-min point found (some ring
-// faces stay negative there, by as little as possible). `work`, if given, counts the
-// subgradient steps taken (the callers' budget).
-bool kernel_point(const RowMat3d& S, const std::vector<std::array<int, 2>>& ring, const Eigen::Vector3d& start,
-                  Eigen::Vector3d* out, Eigen::Vector3d* compromise = nullptr, long* work = nullptr) {
-  std::vector<Eigen::Vector3d> nrm;
-  for (const auto& r : ring) {
-    Eigen::Vector3d n = S.row(r[0]).transpose().cross(S.row(r[1]).transpose());
-    double l = n.norm();
-    if (l > 0) nrm.push_back(n / l);
-  }
-  if (nrm.empty()) return false;
-  auto valid = [&](const Eigen::Vector3d& x) {
-    for (const auto& r : ring)
-      if (orient3d_origin(x.data(), S.row(r[0]).data(), S.row(r[1]).data()) <= 0) return false;
-    return true;
-  };
-  Eigen::Vector3d x = start.normalized(), best_x = x;
-  double best_min = -1e300;
-  double step = 0.1;
-  for (int it = 0; it < 2000; ++it) {
-    if (work) ++*work;
-    double best = 1e300;
-    size_t arg = 0;
-    for (size_t k = 0; k < nrm.size(); ++k) {
-      double d = nrm[k].dot(x);
-      if (d < best) {
-        best = d;
-        arg = k;
-      }
-    }
-    if (best > 0 && valid(x)) {
-      // Keep climbing a little while it stays valid: a central point survives later moves.
-      Eigen::Vector3d y = (x + 0.5 * step * nrm[arg]).normalized();
-      *out = valid(y) ? y : x;
-      return true;
-    }
-    if (best > best_min) {
-      best_min = best;
-      best_x = x;
-    }
-    x = (x + step * nrm[arg]).normalized();
-    step *= 0.995;
-  }
-  if (compromise) *compromise = best_x;
-  return false;
 }
 
 // A mutable face set with vertex-face incidence, for undoing the network's edge splits.
@@ -172,7 +102,7 @@ bool untangle(const FaceSet& fs, const std::vector<char>& fixed, std::vector<int
       }
       Eigen::Vector3d x, y;
       if (!(mean.norm() > 0)) continue;
-      if (kernel_point(*S, ring, mean, &x, soft ? &y : nullptr, &work)) S->row(v) = x.transpose();
+      if (detail::kernel_point(*S, ring, mean, &x, soft ? &y : nullptr, &work)) S->row(v) = x.transpose();
       else if (soft) S->row(v) = y.transpose();
     }
     std::vector<int> still;
@@ -549,7 +479,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
       sw[static_cast<size_t>(f)] = so.hole_shape_weight;
     }
     RowMatXd P = Pn;
-    SPHEREKIT_RETURN_IF_ERROR(optimize_in_place(P, closed.F, w, sw, fixed, settings, progress, &S));
+    SPHEREKIT_RETURN_IF_ERROR(detail::optimize_in_place(P, closed.F, w, sw, fixed, settings, progress, &S));
   }
   if (warp) {
     // 8. Dense sets: the features outside the network's subset flow onto their targets
@@ -576,7 +506,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
     std::vector<char> all_fixed(static_cast<size_t>(n), 0);
     for (int v : fv) all_fixed[static_cast<size_t>(v)] = 1;
     RowMatXd P = Pn;
-    SPHEREKIT_RETURN_IF_ERROR(optimize_in_place(P, closed.F, w, sw, all_fixed, settings, progress, &S));
+    SPHEREKIT_RETURN_IF_ERROR(detail::optimize_in_place(P, closed.F, w, sw, all_fixed, settings, progress, &S));
   }
   result.times.refine = seconds_since(t0);
   SPHEREKIT_RETURN_IF_ERROR(finish_measure(S, fv));

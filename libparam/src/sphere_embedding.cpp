@@ -343,4 +343,22 @@ Status embed_coarse_to_fine(const EmbedInput& in, const OptimizerSettings& s, co
   return r.run(S);
 }
 
+Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector<double>& face_weight,
+                         const std::vector<double>& shape_weight, const std::vector<char>& fixed,
+                         const OptimizerSettings& s, const ProgressFn& progress, RowMat3d* S) {
+  ProgressiveMesh pm;
+  pm.num_vertices = static_cast<int>(P.rows());
+  pm.F = F;
+  for (int v = 0; v < pm.num_vertices; ++v) pm.base_vertices.push_back(v);
+  for (int f = 0; f < F.rows(); ++f) pm.base_faces.push_back(f);
+  EmbedInput in;
+  in.P = &P;
+  in.pm = &pm;
+  in.face_weight = face_weight;
+  in.face_shape_weight = shape_weight;
+  in.base_positions = *S;
+  in.fixed = fixed;
+  return embed_coarse_to_fine(in, s, progress, S, nullptr);
+}
+
 }  // namespace spherekit::detail

@@ -204,6 +204,9 @@ Result<std::optional<RefinedMember>> refine_added_member(const formats::Collecti
     ro.damping = r.value("damping", ro.damping);
     ro.rounds = r.value("rounds", ro.rounds);
     ro.samples = r.value("samples", ro.samples);
+    // Collections written before the stretch polish have no entry: their members were
+    // refined without it, and an added member is refined as they were.
+    ro.stretch_passes = r.value("stretch_passes", 0);
   }
   ro.template_mesh = 0;
   ro.threads = 1;
@@ -247,7 +250,8 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
     man.options["refinement"] = Json{{"iterations", o.refinement.iterations},
                                      {"damping", o.refinement.damping},
                                      {"rounds", o.refinement.rounds},
-                                     {"samples", o.refinement.samples}};
+                                     {"samples", o.refinement.samples},
+                                     {"stretch_passes", o.refinement.stretch_passes}};
   if (!refinement_failure.empty()) {
     man.method = "consistent (steps 1-2: reference locations; step 6 failed)";
     man.extra["refinement_failure"] = refinement_failure;

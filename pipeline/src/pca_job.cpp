@@ -203,10 +203,12 @@ Result<PcaResult> shape_pca(const PcaJob& a, const ProgressFn& progress,
   rep["collection"] = a.collection;
   rep["size"] = a.size;
   rep["members"] = Json::array();
-  for (std::size_t i = 0; i < n; ++i)
-    rep["members"].push_back({{"name", members.value()[i].name}, {"peak", table.peak[i]},
-                              {"coefficients", std::vector<double>(pca.coefficients.row(static_cast<Eigen::Index>(i)).data(),
-                                                                   pca.coefficients.row(static_cast<Eigen::Index>(i)).data() + r)}});
+  for (std::size_t i = 0; i < n; ++i) {
+    // Row i of a column-major matrix is strided: copied element by element.
+    std::vector<double> c;
+    for (Eigen::Index j = 0; j < static_cast<Eigen::Index>(r); ++j) c.push_back(pca.coefficients(static_cast<Eigen::Index>(i), j));
+    rep["members"].push_back({{"name", members.value()[i].name}, {"peak", table.peak[i]}, {"coefficients", c}});
+  }
   rep["vertices"] = pca.mean.rows();
   rep["faces"] = pca.F.rows();
   rep["components"] = r;

@@ -162,6 +162,19 @@ TEST_CASE("transfer, morph and pca on a consistent sample collection", "[cli][ap
     for (std::size_t k = 1; k < rows.size(); ++k)
       CHECK(rows[k]["mean_rms"].get<double>() <= rows[k - 1]["mean_rms"].get<double>() + 1e-12);
     CHECK(rows[2]["max_rms"].get<double>() < 1e-7 * p["members"][0]["peak"].get<double>());
+    // The members' coefficients are projections of centred shapes: each component's sum
+    // over the members is 0, and its square sum is the squared singular value.
+    for (int j = 0; j < 2; ++j) {
+      double sum = 0, sq = 0;
+      for (const json& m : p["members"]) {
+        REQUIRE(m["coefficients"].size() == 2);
+        sum += m["coefficients"][j].get<double>();
+        sq += std::pow(m["coefficients"][j].get<double>(), 2);
+      }
+      const double sv = p["singular_values"][j].get<double>();
+      CHECK(std::abs(sum) < 1e-9 * sv);
+      CHECK(sq == Approx(sv * sv).epsilon(1e-9));
+    }
     bool draco = false;
     for (const json& c : p["compression"]) draco = draco || c["method"] == "draco";
     CHECK(draco);

@@ -231,6 +231,7 @@ TEST_CASE("shared faust5k: 64 and 128 dense landmarks, 2 members, give a complet
   ConsistentParamOptions o;
   o.threads = 2;
   auto r = parameterize_consistent({a, b}, sets, o);
+  INFO((r.ok() ? std::string() : r.status().message()));
   REQUIRE(r.ok());
   CHECK(r->refinement_failure.empty());  // no step fell back
   CHECK(r->joint_flips == 0);

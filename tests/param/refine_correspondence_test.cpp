@@ -5,11 +5,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "test_meshes.h"
+#include "spherekit/consistent_param.h"
 #include "spherekit/correspondence.h"
 #include "spherekit/metrics.h"
 #include "spherekit/refine_correspondence.h"
@@ -163,6 +168,7 @@ TEST_CASE("refinement works with holes in the template, and refuses bad argument
   REQUIRE(out.ok());
   INFO(out->members[1].note);
   REQUIRE(out->members[1].refined);
+  CHECK(out->members[1].note.empty());  // every round polished: the holes' fans found a place
   CHECK(count_flipped_faces(F, maps[1]) == 0);
   CHECK(maps[1].row(c.feature) == St.row(c.feature));
   const double before = copy_error(c.tmpl, St, c.copy, S1), after = copy_error(c.tmpl, St, c.copy, maps[1]);
@@ -180,4 +186,150 @@ TEST_CASE("refinement works with holes in the template, and refuses bad argument
   bad.damping = 0;
   CHECK(refine_correspondence(meshes, features, maps, bad).status().code() == ErrorCode::InvalidArgument);
   CHECK(refine_correspondence(meshes, out_of_range, maps).status().code() == ErrorCode::InvalidArgument);
+  bad.damping = 0.01;
+  bad.stretch_passes = -1;
+  CHECK(refine_correspondence(meshes, features, maps, bad).status().code() == ErrorCode::InvalidArgument);
+}
+
+TEST_CASE("the stretch polish after each flow raises the efficiency and keeps the agreement", "[refine]") {
+  const TwistCase c = twist_case();
+  const RowMat3d S1 = twisted(c.St, c.St.row(c.feature).transpose(), 0.5);
+  const double before = copy_error(c.tmpl, c.St, c.copy, S1);
+  std::vector<TriMesh> meshes{c.tmpl, c.copy};
+  std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
+  auto refine = [&](int passes, RefinedMember* rep) {
+    std::vector<RowMat3d> maps{c.St, S1};
+    RefineCorrespondenceOptions o;
+    o.threads = 1;
+    o.stretch_passes = passes;
+    auto r = refine_correspondence(meshes, features, maps, o);
+    REQUIRE(r.ok());
+    *rep = r->members[1];
+    REQUIRE(rep->refined);
+    return maps[1];
+  };
+  RefinedMember plain, polished;
+  const RowMat3d Sf = refine(0, &plain), Sp = refine(3, &polished);
+  INFO(polished.note);
+  CHECK(polished.note.empty());
+  CHECK(count_flipped_faces(c.copy.F, Sp) == 0);
+  CHECK(Sp.row(c.feature) == c.St.row(c.feature));
+  auto m = evaluate_sphere_map(c.copy, Sp);
+  REQUIRE(m.ok());
+  CHECK(m->winding == Approx(1.0).margin(1e-9));
+  // The flow leaves stretch between its samples that the polish takes out ...
+  INFO("efficiency unpolished " << plain.efficiency_after << ", polished " << polished.efficiency_after
+                                << ", the template's own " << evaluate_sphere_map(c.tmpl, c.St)->efficiency);
+  CHECK(polished.efficiency_after > plain.efficiency_after);
+  // ... while the agreement the fit made stays.
+  const double e_plain = copy_error(c.tmpl, c.St, c.copy, Sf), e_polished = copy_error(c.tmpl, c.St, c.copy, Sp);
+  INFO("error before " << before << ", unpolished " << e_plain << ", polished " << e_polished);
+  CHECK(e_polished < 0.35 * before);
+  CHECK(e_polished < 1.25 * e_plain);
+}
+
+namespace {
+
+// The same surface with other connectivity: a set of non-adjacent edge flips of nearly flat
+// edges (the surface moves by far less than an edge), vertices renumbered, the whole moved
+// rigidly. The intrinsic metric is the template's up to the flipped chords; vertex v of the
+// template is vertex perm[v] of the copy (the ground truth).
+TriMesh flipped_copy(const TriMesh& m, std::uint64_t seed, std::vector<int>* perm, int* flips) {
+  RowMat3i F = m.F;
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = F(f, k), b = F(f, (k + 1) % 3);
+      edge_faces[{std::min(a, b), std::max(a, b)}].push_back(static_cast<int>(f));
+    }
+  std::set<std::pair<int, int>> edges;
+  for (const auto& [e, fs] : edge_faces) edges.insert(e);
+  std::vector<char> touched(static_cast<size_t>(m.V.rows()), 0);
+  std::mt19937_64 rng(seed);
+  *flips = 0;
+  for (const auto& [e, fs] : edge_faces) {
+    if (fs.size() != 2 || rng() % 2) continue;
+    const int f0 = fs[0], f1 = fs[1];
+    auto opposite = [&](int f) {
+      for (int k = 0; k < 3; ++k)
+        if (F(f, k) != e.first && F(f, k) != e.second) return F(f, k);
+      return -1;
+    };
+    const int c = opposite(f0), d = opposite(f1);
+    const int a = e.first, b = e.second;
+    if (touched[static_cast<size_t>(a)] || touched[static_cast<size_t>(b)] || touched[static_cast<size_t>(c)] ||
+        touched[static_cast<size_t>(d)] || edges.count({std::min(c, d), std::max(c, d)}))
+      continue;
+    const Eigen::Vector3d n0 = (m.V.row(F(f0, 1)) - m.V.row(F(f0, 0))).cross(m.V.row(F(f0, 2)) - m.V.row(F(f0, 0))).normalized();
+    const Eigen::Vector3d n1 = (m.V.row(F(f1, 1)) - m.V.row(F(f1, 0))).cross(m.V.row(F(f1, 2)) - m.V.row(F(f1, 0))).normalized();
+    if (n0.dot(n1) < 0.995) continue;  // nearly flat: the flip barely moves the surface
+    // f0 = (a, b, c) in some rotation with a -> b its edge direction, or (b, a, c).
+    int p = a, q = b;
+    for (int k = 0; k < 3; ++k)
+      if (F(f0, k) == b && F(f0, (k + 1) % 3) == a) p = b, q = a;
+    F.row(f0) << p, d, c;  // c -> p -> d and d -> q -> c keep the orientation
+    F.row(f1) << q, c, d;
+    for (int v : {a, b, c, d}) touched[static_cast<size_t>(v)] = 1;
+    ++*flips;
+  }
+  perm->resize(static_cast<size_t>(m.V.rows()));
+  std::iota(perm->begin(), perm->end(), 0);
+  std::shuffle(perm->begin(), perm->end(), rng);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(-2, 1, 0.5).normalized()).toRotationMatrix();
+  TriMesh out;
+  out.V.resize(m.V.rows(), 3);
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v)
+    out.V.row((*perm)[static_cast<size_t>(v)]) = (R * m.V.row(v).transpose() + Eigen::Vector3d(1, 2, -0.5)).transpose();
+  out.F.resize(F.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) out.F(f, k) = (*perm)[static_cast<size_t>(F(f, k))];
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("two isometric copies with different connectivity correspond after refinement", "[refine][consistent]") {
+  const TriMesh a = test::random_blob(4, 11);
+  std::vector<int> perm;
+  int flips = 0;
+  const TriMesh b = flipped_copy(a, 5, &perm, &flips);
+  REQUIRE(flips > a.F.rows() / 20);  // really other connectivity
+  // Four features: the extremes along x and y of the template, the same vertices on the copy.
+  std::vector<int> fa;
+  for (int axis = 0; axis < 2; ++axis) {
+    int lo = 0, hi = 0;
+    a.V.col(axis).minCoeff(&lo);
+    a.V.col(axis).maxCoeff(&hi);
+    fa.push_back(lo);
+    fa.push_back(hi);
+  }
+  std::vector<int> fb;
+  for (int v : fa) fb.push_back(perm[static_cast<size_t>(v)]);
+  auto error = [&](const ConsistentParamResult& r) {
+    std::vector<SurfacePoint> pts;
+    for (Eigen::Index v = 0; v < a.V.rows(); ++v) pts.push_back(vertex_surface_point(a, static_cast<int>(v)));
+    auto moved = transfer_points(a, r.maps[0].map.S, pts, b, r.maps[1].map.S);
+    REQUIRE(moved.ok());
+    double sum = 0;
+    for (Eigen::Index v = 0; v < a.V.rows(); ++v)
+      sum += (surface_position(b, (*moved)[static_cast<size_t>(v)].point) - b.V.row(perm[static_cast<size_t>(v)]).transpose()).norm();
+    return sum / static_cast<double>(a.V.rows()) / std::sqrt(mesh_area(b));
+  };
+  ConsistentParamOptions o;
+  o.threads = 2;
+  o.refine_correspondence = false;
+  auto plain = parameterize_consistent({a, b}, {fa, fb}, o);
+  REQUIRE(plain.ok());
+  o.refine_correspondence = true;
+  auto refined = parameterize_consistent({a, b}, {fa, fb}, o);
+  REQUIRE(refined.ok());
+  INFO(refined->refinement.members[1].note);
+  REQUIRE(refined->refinement.members[1].refined);
+  const double before = error(*plain), after = error(*refined);
+  INFO("mean error / sqrt(area): without refinement " << before << ", with " << after);
+  CHECK(after < 0.01);
+  CHECK(before > 3 * after);
+  CHECK(refined->maps[1].flipped_faces == 0);
+  for (size_t k = 0; k < fb.size(); ++k)
+    CHECK(refined->maps[1].map.S.row(fb[k]) == refined->maps[0].map.S.row(fa[k]));
 }

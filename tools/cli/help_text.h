@@ -64,9 +64,10 @@ inline constexpr const char* kConsistent =
     "6 constrained maps of all meshes to F. --no-refine-locations stops after step 2.\n"
     "Then the correspondence is refined: each other mesh's map is fitted to the reference's so\n"
     "that the maps agree between the features (the reference's surface carried onto each mesh\n"
-    "as rigidly as possible, the map flowed onto it; bijective, features exact, a round that\n"
-    "would cost over 20% of a map's stretch efficiency is not taken; collection.json records\n"
-    "what it did per member). --no-refine-correspondence keeps the step-6 maps.\n"
+    "as rigidly as possible, the map flowed onto it, then a few stretch passes; bijective,\n"
+    "features exact, a round that would cost over 20% of a map's stretch efficiency is not\n"
+    "taken; collection.json records what it did per member). --no-refine-correspondence keeps\n"
+    "the step-6 maps.\n"
     "Writes the folder -o DIR: collection.json (manifest), features.txt (`name x y z`: F) and\n"
     "<stem>.sphere.obj per mesh; DIR is replaced only when everything succeeded. Feature files\n"
     "default to NAME.lm.txt beside each mesh. Without meshes, the built-in sample collection.";

@@ -33,4 +33,11 @@ struct EmbedStats {
 Status embed_coarse_to_fine(const EmbedInput& in, const OptimizerSettings& s, const ProgressFn& progress,
                             RowMat3d* S, EmbedStats* stats);
 
+/// Final optimization of a complete mesh whose map S is already valid (#V by 3, bijective),
+/// `fixed` vertices standing still: the coarse-to-fine machinery on a progressive mesh
+/// without collapses runs just its final passes (s.final_iter). Errors as above.
+Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector<double>& face_weight,
+                         const std::vector<double>& shape_weight, const std::vector<char>& fixed,
+                         const OptimizerSettings& s, const ProgressFn& progress, RowMat3d* S);
+
 }  // namespace spherekit::detail

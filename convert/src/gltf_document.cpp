@@ -6,6 +6,7 @@
 #include "gltf_document.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstring>
 #include <exception>
 #include <limits>
@@ -100,6 +101,19 @@ int GlbBuilder::add_index_accessor(const RowMat3i& F, std::int64_t points) {
   return static_cast<int>(model_.accessors.size()) - 1;
 }
 
+double shortest_float_decimal(float x) {
+  // std::to_chars without a precision writes the shortest decimal that reads back as x;
+  // that decimal as a double is printed the same way by the JSON writer (shortest round trip).
+  // (to_chars/from_chars: no locale, unlike strtod.)
+  char buf[32];
+  const std::to_chars_result r = std::to_chars(buf, buf + sizeof buf, x);
+  double d = static_cast<double>(x);
+  std::from_chars(buf, r.ptr, d);
+  // Decimal -> double -> float rounds twice; keep the exact value in the (rare) case that
+  // changes the float.
+  return static_cast<float>(d) == x ? d : static_cast<double>(x);
+}
+
 int GlbBuilder::add_draco_mesh(const DracoPrimitive& primitive, const std::string& name, tinygltf::Value extras) {
   const GltfMesh& d = primitive.decoded.mesh;
   const auto points = static_cast<std::size_t>(d.V.rows());
@@ -109,13 +123,18 @@ int GlbBuilder::add_draco_mesh(const DracoPrimitive& primitive, const std::strin
 
   // POSITION must define min and max (glTF 2.0 "Meshes"); they are the decoded floats' bounds,
   // which is what a loader sees after decompression.
-  std::vector<double> lo(3, std::numeric_limits<double>::infinity()), hi(3, -lo[0]);
+  std::vector<float> flo(3, std::numeric_limits<float>::infinity()), fhi(3, -flo[0]);
   for (std::size_t p = 0; p < points; ++p)
     for (int c = 0; c < 3; ++c) {
-      const double x = static_cast<double>(static_cast<float>(d.V(static_cast<Eigen::Index>(p), c)));
-      lo[static_cast<std::size_t>(c)] = std::min(lo[static_cast<std::size_t>(c)], x);
-      hi[static_cast<std::size_t>(c)] = std::max(hi[static_cast<std::size_t>(c)], x);
+      const auto x = static_cast<float>(d.V(static_cast<Eigen::Index>(p), c));
+      flo[static_cast<std::size_t>(c)] = std::min(flo[static_cast<std::size_t>(c)], x);
+      fhi[static_cast<std::size_t>(c)] = std::max(fhi[static_cast<std::size_t>(c)], x);
     }
+  std::vector<double> lo, hi;
+  for (int c = 0; c < 3; ++c) {
+    lo.push_back(shortest_float_decimal(flo[static_cast<std::size_t>(c)]));
+    hi.push_back(shortest_float_decimal(fhi[static_cast<std::size_t>(c)]));
+  }
   prim.attributes["POSITION"] = add_accessor_without_data(kFloat, TINYGLTF_TYPE_VEC3, points, lo, hi);
   draco_attributes["POSITION"] = tinygltf::Value(primitive.decoded.position_id);
   if (d.N.rows() > 0) {
@@ -138,7 +157,7 @@ int GlbBuilder::add_draco_mesh(const DracoPrimitive& primitive, const std::strin
   tinygltf::Mesh mesh;
   mesh.name = name;
   mesh.primitives.push_back(std::move(prim));
-  mesh.extras = std::move(extras);
+  mesh.extras = std::move(extras);  // a null Value is not written
   model_.meshes.push_back(std::move(mesh));
   return static_cast<int>(model_.meshes.size()) - 1;
 }

@@ -55,8 +55,9 @@ class GlbBuilder {
   int add_index_accessor(const RowMat3i& F, std::int64_t points);
 
   /// A mesh with one Draco-compressed primitive: accessors from the decoded data (counts,
-  /// POSITION min/max of the decoded floats), KHR_draco_mesh_compression pointing at a new
-  /// bufferView holding `primitive.bytes`. Returns the mesh index.
+  /// POSITION min/max of the decoded floats, written as their shortest decimals),
+  /// KHR_draco_mesh_compression pointing at a new bufferView holding `primitive.bytes`;
+  /// `extras` null: none. Returns the mesh index.
   int add_draco_mesh(const DracoPrimitive& primitive, const std::string& name, tinygltf::Value extras);
 
   /// Declares an extension used (once), and required if `required`.
@@ -68,6 +69,11 @@ class GlbBuilder {
  private:
   tinygltf::Model model_;
 };
+
+/// The shortest decimal that reads back as `x` (as float), as a double: 0.1f gives 0.1, not
+/// 0.100000001490116. POSITION bounds are written so (a float's exact double value needs up to
+/// 17 digits; a level file's JSON is part of its size), and still read back as the same float.
+double shortest_float_decimal(float x);
 
 /// JSON helpers for extras.
 tinygltf::Value json_number(double x);

@@ -164,6 +164,8 @@ Result<QuantizationChoice> choose_draco_quantization(const GltfMesh& finest, dou
     if (T > 1) {
       // Texel-centre grid: origin 1/(2T), step 1/(T m) with m = floor((2^b - 1)/(T - 1)) >= 1,
       // so texel centre j is grid value j*m and the last centre, (T-1)/T past the origin, fits.
+      // The fewest bits that hold the lattice (m = 1 for T = 2^k + 1; QuantizationBudget).
+      q.texcoord_bits = 1;
       while (q.texcoord_bits < kMaxDracoBits && std::ldexp(1.0, q.texcoord_bits) - 1.0 < T - 1) ++q.texcoord_bits;
       const double levels = std::ldexp(1.0, q.texcoord_bits) - 1.0;
       const double m = std::floor(levels / (T - 1));

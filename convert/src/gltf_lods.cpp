@@ -34,6 +34,19 @@ tinygltf::Value level_extras(int level, int image_size, int texture_size, const 
   return detail::json_object(std::move(extras));
 }
 
+// asset.extras of a level's own file: only what reading TEXCOORD_0 needs (the level and the
+// texture's side). The file is compared by size against other tools' files, and its JSON was
+// a third of a coarse level's bytes; provenance and quantization are in the combined file
+// (level_extras, asset_extras) and in the convert report.
+tinygltf::Value level_file_extras(int level, int texture_size) {
+  tinygltf::Value::Object o;
+  o["lod"] = detail::json_int(level);
+  o["texture_size"] = detail::json_int(texture_size);
+  tinygltf::Value::Object extras;
+  extras["spherekit"] = detail::json_object(std::move(o));
+  return detail::json_object(std::move(extras));
+}
+
 tinygltf::Value asset_extras(const GltfLodOptions& options, int texture_size, int levels) {
   tinygltf::Value::Object o;
   o["source_mesh"] = detail::json_string(options.provenance.source_mesh);
@@ -246,6 +259,16 @@ QuantizationChoice coarse_quantization(const QuantizationChoice& shared, const G
   return q;
 }
 
+// Texture-coordinate bits of original level k: level 0's less k. Level k has 1/4^k of level 0's
+// vertices, so edges 2^k times as long, and it is shown at most at 1/2^k of level 0's size (the
+// screen coverages halve per level): a grid step 2^k times level 0's is the same fraction of its
+// triangles, and the same distance on screen, which is half a texel of the mip level sampled
+// there (mip k). Floored at kMinCoarseTexcoordBits, a 16-step grid over the octahedral domain.
+constexpr int kMinCoarseTexcoordBits = 4;
+int coarse_texcoord_bits(int level0_bits, int level) {
+  return std::max(std::min(level0_bits, kMinCoarseTexcoordBits), level0_bits - level);
+}
+
 Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
                                    const GltfLodOptions& options, const ProgressFn& progress, const TriMesh* finest) {
   const int levels = static_cast<int>(meshes.size());
@@ -314,12 +337,21 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     level.mesh = std::move(meshes[static_cast<std::size_t>(k)]);
     if (!options.normals) level.mesh.N.resize(0, 3);
     level.quantization = out.quantization;
+    if (options.mode == LodMode::Original && options.coarse_texcoord_bits)
+      level.quantization.quantization.texcoord_bits = coarse_texcoord_bits(encode.quantization.texcoord_bits, k);
     const double level_error = level_errors.empty() ? 0.0 : level_errors[static_cast<std::size_t>(k)];
     if (level_error > 0) {
       DracoEncodeOptions level_encode = encode;
+      level_encode.quantization.texcoord_bits = level.quantization.quantization.texcoord_bits;
+      // The file's bytes around the bitstream (GLB headers, JSON: ~0.8 KB, a third of a coarse
+      // level), as in the previous level's file, count in the rate: the file is what a viewer
+      // downloads (cat0's level 2: 8 -> 9 bits, 1.16 -> 1.15 x gltf-transform at equal PSNR).
+      const double fixed =
+          k > 0 ? static_cast<double>(out.levels.back().glb.size() - out.levels.back().primitive.bytes.size()) : 0.0;
       SPHEREKIT_ASSIGN_OR_RETURN(PositionBitsChoice c, choose_position_bits(level.mesh, level_encode, level_error, gamma,
                                                                             std::min(options.min_position_bits_rd,
-                                                                                     encode.quantization.position_bits)));
+                                                                                     encode.quantization.position_bits),
+                                                                            fixed));
       level.quantization.quantization.position_bits = c.bits;
       level.quantization.reference_rms_error = level_error;
       level.quantization.position_max_error = level.quantization.quantization.position_step() / 2;
@@ -334,9 +366,7 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     }
 
     detail::GlbBuilder doc;
-    const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k),
-                                     level_extras(k, level.image_size, n, level.quantization, options.mode,
-                                                  level.mesh.N.rows() > 0));
+    const int m = doc.add_draco_mesh(level.primitive, level_name(options.name, k), tinygltf::Value());
     tinygltf::Node node;
     node.name = level_name(options.name, k);
     node.mesh = m;
@@ -344,7 +374,7 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     doc.model().scenes.emplace_back();
     doc.model().scenes[0].nodes = {0};
     doc.model().defaultScene = 0;
-    doc.model().asset.extras = asset_extras(options, n, 1);
+    doc.model().asset.extras = level_file_extras(k, n);
     SPHEREKIT_ASSIGN_OR_RETURN(level.glb, doc.to_glb());
     out.levels.push_back(std::move(level));
   }

@@ -15,7 +15,8 @@ double rate_exponent(double vertices_fine, double error_fine, double vertices_co
 }
 
 Result<PositionBitsChoice> choose_position_bits(const GltfMesh& mesh, const DracoEncodeOptions& options,
-                                                double level_error_rms, double gamma, int min_bits) {
+                                                double level_error_rms, double gamma, int min_bits,
+                                                double fixed_bytes) {
   const int top = options.quantization.position_bits;
   if (!(level_error_rms > 0) || !std::isfinite(level_error_rms))
     return Status(ErrorCode::InvalidArgument, "position bits: the level's error must be > 0");
@@ -34,7 +35,7 @@ Result<PositionBitsChoice> choose_position_bits(const GltfMesh& mesh, const Drac
     ++best.encodes;
     const double q = o.quantization.position_step() / std::sqrt(24.0);
     const double ratio2 = (q / level_error_rms) * (q / level_error_rms);
-    const double cost = static_cast<double>(p.bytes.size()) * std::pow(1.0 + ratio2, gamma / 2);
+    const double cost = (static_cast<double>(p.bytes.size()) + fixed_bytes) * std::pow(1.0 + ratio2, gamma / 2);
     rises = cost > last_cost ? rises + 1 : 0;
     last_cost = cost;
     // Ties keep the finer grid (the first one met).

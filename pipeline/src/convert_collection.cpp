@@ -53,6 +53,7 @@ Json member_json(const ConvertedMember& m, const ConvertOptions& o, const std::s
                  {"bytes", file_bytes(g.lod_paths.levels[l])},
                  {"size", g.lods.levels[l].image_size}};
       if (l < g.lod_errors.size()) level["psnr_db"] = number_or_null(g.lod_errors[l].psnr);
+      level["quantization"] = lod_quantization_json(g.lods.levels[l]);
       levels.push_back(std::move(level));
     }
     j["lods"] = std::move(levels);

@@ -54,6 +54,18 @@ Result<ConvertMeshResult> convert_mesh(const ConvertMeshJob& job, const Progress
   return out;
 }
 
+Json lod_quantization_json(const convert::GltfLodLevel& level) {
+  const convert::QuantizationChoice& c = level.quantization;
+  Json j;
+  j["position_bits"] = c.quantization.position_bits;
+  j["position_max_error"] = c.position_max_error;
+  j["reference_rms_error"] = c.reference_rms_error;
+  j["decided_by"] = c.rate_distortion ? "rate-distortion" : c.reference_rms_error > 0 ? "error budget" : "minimum bits";
+  if (level.mesh.UV.rows() > 0) j["texcoord_bits"] = c.quantization.texcoord_bits;
+  if (level.mesh.N.rows() > 0) j["normal_bits"] = c.quantization.normal_bits;
+  return j;
+}
+
 Json to_json(const CageAssets& c) {
   Json j;
   j["file"] = c.cage_path;
@@ -123,6 +135,7 @@ Json to_json(const ConvertMeshResult& r) {
         l["psnr_db"] = number_or_null(g.lod_errors[k].psnr);
         l["rms"] = g.lod_errors[k].rms;
       }
+      l["quantization"] = lod_quantization_json(level);
       levels.push_back(std::move(l));
     }
     j["lods"] = std::move(levels);

@@ -93,7 +93,9 @@ TEST_CASE("Draco quantization from an error budget", "[convert]") {
     REQUIRE(q.ok());
     CHECK(q->quantization.position_bits == 14);
     CHECK(q->quantization.normal_bits == 10);
-    CHECK(q->quantization.texcoord_bits == 12);
+    // A 33 x 33 texel lattice: the fewest bits holding it, one grid step per texel.
+    CHECK(q->quantization.texcoord_bits == 6);
+    CHECK(q->quantization.texcoord_step() == Approx(1.0 / 33));
     CHECK(q->position_max_error == Approx(q->quantization.position_step() / 2));
     // The grid is the bounding box as a cube of its largest extent.
     const double extent = (m->V.colwise().maxCoeff() - m->V.colwise().minCoeff()).maxCoeff();
@@ -128,7 +130,7 @@ TEST_CASE("Draco quantization from an error budget", "[convert]") {
       REQUIRE(std::abs(k - std::round(k)) < 1e-3);
       REQUIRE(std::round(k) <= std::ldexp(1.0, d.texcoord_bits) - 1);
     }
-    // A large texture needs more than the floor of 12 bits: 2^bits - 1 >= T - 1.
+    // A large texture needs more bits: 2^bits - 1 >= T - 1.
     GltfMesh big = m.value();
     big.texture_size = 8193;
     big.UV *= 33.0 / 8193;

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -43,6 +44,7 @@ TEST_CASE("glTF LOD files: each Draco primitive decodes to its accessors and to 
   const double half_step = q.position_step() / 2, float_slack = 4 * 1.2e-7 * (q.position_range + 2);
   const int T = gi.size;
 
+  const test::GlbFile combined = test::parse_glb(test::slurp(paths->combined));
   std::map<int, Eigen::RowVector3f> level0_positions;  // texel -> decoded position in level 0
   for (int k = 0; k < 3; ++k) {
     INFO("level " << k);
@@ -55,15 +57,18 @@ TEST_CASE("glTF LOD files: each Draco primitive decodes to its accessors and to 
     CHECK(j.at("extensionsRequired") == nlohmann::json::array({"KHR_draco_mesh_compression"}));
     CHECK(j.at("scenes").at(0).at("nodes") == nlohmann::json::array({0}));
     CHECK(j.at("nodes").at(0).at("name") == "blob_LOD" + std::to_string(k));
-    // Quantization and provenance are recorded.
-    const auto& extras = j.at("meshes").at(0).at("extras").at("spherekit");
+    // Quantization and provenance are recorded in the combined file; the level's own file
+    // says only which level it is and the texture side its TEXCOORD_0 refers to.
+    const auto& extras = combined.json.at("meshes").at(static_cast<std::size_t>(k)).at("extras").at("spherekit");
     CHECK(extras.at("lod") == k);
     CHECK(extras.at("geometry_image_size") == n);
     CHECK(extras.at("texture_size") == T);
     CHECK(extras.at("quantization").at("position_bits") == q.position_bits);
     CHECK(extras.at("quantization").at("normal_bits") == 10);
     CHECK(extras.at("quantization").at("budget").at("reference_rms_error").get<double>() == 1e-4);
-    CHECK(j.at("asset").at("extras").at("spherekit").at("source_mesh") == "blob.obj");
+    CHECK(combined.json.at("asset").at("extras").at("spherekit").at("source_mesh") == "blob.obj");
+    CHECK(j.at("asset").at("extras") == nlohmann::json{{"spherekit", {{"lod", k}, {"texture_size", T}}}});
+    CHECK_FALSE(j.at("meshes").at(0).contains("extras"));
 
     const auto decoded = test::decode_and_check_draco(glb);
     REQUIRE(decoded.size() == 1);
@@ -258,4 +263,53 @@ TEST_CASE("glTF LODs: errors and cancellation", "[convert]") {
   auto w = write_gltf_lods(dir + "/no/such/folder/x", lods.value());
   CHECK(w.status().code() == ErrorCode::IoError);
   CHECK(w.status().message().find("x_lod0.glb") != std::string::npos);
+}
+
+TEST_CASE("glTF LOD level files: minimal JSON, POSITION bounds as shortest decimals", "[convert]") {
+  // A level's own file is what a viewer downloads and what is compared against other tools'
+  // files: only the properties glTF and KHR_draco_mesh_compression require, the names, and a
+  // two-field extras object; provenance and quantization are in the combined file.
+  auto built = build_gltf_lods(test::lod_test_image(), test::lod_test_options());
+  REQUIRE(built.ok());
+  for (std::size_t k = 0; k < built->levels.size(); ++k) {
+    INFO("level " << k);
+    const std::string& glb = built->levels[k].glb;
+    const test::GlbFile file = test::parse_glb(glb);
+    std::vector<std::string> keys;
+    for (const auto& [key, value] : file.json.items()) keys.push_back(key);
+    CHECK(keys == std::vector<std::string>{"accessors", "asset", "bufferViews", "buffers", "extensionsRequired",
+                                           "extensionsUsed", "meshes", "nodes", "scene", "scenes"});
+    CHECK(file.json.at("asset").at("extras").at("spherekit").size() == 2);
+    // Every POSITION bound is written as the shortest decimal of its float (to_chars), and
+    // (decode_and_check_draco) reads back as the decoded floats' bound exactly.
+    const std::uint32_t json_bytes = static_cast<std::uint8_t>(glb[12]) | static_cast<std::uint8_t>(glb[13]) << 8 |
+                                     static_cast<std::uint8_t>(glb[14]) << 16 |
+                                     static_cast<std::uint32_t>(static_cast<std::uint8_t>(glb[15])) << 24;
+    const std::string text = glb.substr(20, json_bytes);
+    int bounds = 0;
+    for (const char* key : {"\"max\":[", "\"min\":["}) {
+      const std::size_t at = text.find(key);
+      REQUIRE(at != std::string::npos);
+      std::size_t p = at + std::string(key).size();
+      const std::size_t end = text.find(']', p);
+      while (p < end) {
+        std::size_t q = text.find_first_of(",]", p);
+        const std::string number = text.substr(p, q - p);
+        float x = 0;
+        std::from_chars(number.data(), number.data() + number.size(), x);
+        char shortest[32];
+        const auto r = std::to_chars(shortest, shortest + sizeof shortest, x);
+        CHECK(number == std::string(shortest, r.ptr));
+        ++bounds;
+        p = q + 1;
+      }
+    }
+    CHECK(bounds == 6);
+    const auto decoded = test::decode_and_check_draco(file);
+    CHECK(decoded.size() == 1);
+    // This fixture's levels (POSITION, NORMAL, TEXCOORD_0) take 892-896 bytes of JSON; with
+    // full-precision bounds and the provenance and quantization extras it was ~1.5 KB.
+    INFO(text);
+    CHECK(json_bytes < 960);
+  }
 }

@@ -75,6 +75,14 @@ TEST_CASE("convert_mesh: image, previews, levels of detail, cage, measured and r
   CHECK(j["size"] == 17);
   CHECK(j["positions"] == "fit");
   CHECK(j["lods"].size() == 2);
+  // Each level's quantization is in the report (its own .glb carries none of it).
+  for (std::size_t k = 0; k < 2; ++k) {
+    const pipeline::Json& q = j["lods"][k]["quantization"];
+    CHECK(q["position_bits"] == g.lods.levels[k].quantization.quantization.position_bits);
+    CHECK(q["texcoord_bits"] == g.lods.levels[k].quantization.quantization.texcoord_bits);
+    CHECK(q["position_max_error"].get<double>() > 0);
+    CHECK(q.contains("decided_by"));
+  }
   CHECK(j["cage"]["displacement"] == "scalar");
   CHECK(j["cage"]["bytes"].get<long long>() > 0);
   CHECK(j["psnr_db"].get<double>() == Approx(g.error.psnr));
@@ -135,6 +143,8 @@ TEST_CASE("convert_collection: every member into one folder with one layout and 
   CHECK(std::count(names.begin(), names.end(), "convert_report.json") == 1);
   CHECK(formats::read_file(dir + "/assets/convert_report.json").value() == r->report.dump(2) + "\n");
   CHECK(r->report["members"][1]["cage"]["file"] == "m1_cage.obj");
+  CHECK(r->report["members"][1]["lods"][1]["quantization"]["position_bits"] ==
+        r->members[1].assets.lods.levels[1].quantization.quantization.position_bits);
   CHECK(r->report["feature_texels"][0]["name"] == "north");
 
   SECTION("cancelled between members: the folder is not replaced") {

@@ -10,6 +10,10 @@ SPHERE = collection:DIR measures member NAME of the consistent collection DIR (i
 `convert --collection`, adaptive: one connectivity for all members) against the peers run on
 MESH alone.
 
+Our levels' position bits come from the convert report (the level files carry no quantization
+extras). PEERS_FROM=PREVIOUS.json reuses the peers of an earlier run on the same mesh (only bit
+counts it lacks are run), to compare versions of ours against the same peer files.
+
 Needs the npm tools of scripts/setup_npm_tools.sh --compare (NODE_DIR, default
 ~/.cache/spherekit/npm-tools). Peers run at every position-bit count one of our levels uses
 (their smallest size at each PSNR counts, so no level is compared against a peer at more bits
@@ -34,10 +38,6 @@ def psnr(glb):
     run(['node', here + '/glb2obj.mjs', glb, glb + '.obj'])
     return json.loads(run([sk, 'eval-surface', mesh, glb + '.obj', '--samples', '100000', '--json']))['psnr_db']
 
-def extras_bits(glb):
-    js = ("const b=require('fs').readFileSync(process.argv[1]);const n=b.readUInt32LE(12);"
-          "const j=JSON.parse(b.slice(20,20+n));console.log(j.meshes[0].extras.spherekit.quantization.position_bits)")
-    return int(run(['node', '-e', js, glb]))
 
 def interp(points, p):
     pts = sorted(points)
@@ -59,19 +59,26 @@ for mode, args in modes.items():
         run([sk, 'convert', '--collection', sphere[len('collection:'):], '-o', f'{d}/{mode}_collection',
              '--lods', '4', '--quiet'] + args)
         level_file = lambda k: f'{d}/{mode}_collection/{name}_lod{k}.glb'
+        report = json.load(open(f'{d}/{mode}_collection/convert_report.json'))
+        levels = next(m for m in report['members'] if m['name'] == name)['lods']
     else:
-        run([sk, 'convert', mesh, sphere, '-o', f'{d}/{mode}.exr', '--lods', '4', '--quiet'] + args)
+        run([sk, 'convert', mesh, sphere, '-o', f'{d}/{mode}.exr', '--lods', '4', '--quiet',
+             '--report', f'{d}/{mode}_report.json'] + args)
         level_file = lambda k: f'{d}/{mode}_lod{k}.glb'
+        levels = json.load(open(f'{d}/{mode}_report.json'))['lods']
     ours[mode] = []
     for k in range(4):
         f = level_file(k)
-        b = extras_bits(f)
+        b = levels[k]['quantization']['position_bits']
         bits.add(b)
         ours[mode].append({'psnr': psnr(f), 'bytes': os.path.getsize(f), 'position_bits': b})
 
 run([B + '/gltfpack', '-i', obj, '-o', f'{d}/plain.glb', '-noq'])
 peers = {'gltfpack': [], 'gltf-transform': []}
-for pb in sorted(bits):
+if os.environ.get('PEERS_FROM'):
+    peers = json.load(open(os.environ['PEERS_FROM']))['peers']
+have = {q['position_bits'] for q in peers['gltfpack']}
+for pb in sorted(bits - have):
     for r in ['1', '0.5', '0.25', '0.125', '0.06', '0.03', '0.015', '0.008', '0.004', '0.002']:
         g = f'{d}/gp{pb}_{r}.glb'
         run([B + '/gltfpack', '-i', obj, '-o', g, '-cc', '-vp', str(pb)] + ([] if r == '1' else ['-si', r]))

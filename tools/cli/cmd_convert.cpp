@@ -118,7 +118,8 @@ void register_convert(CLI::App& app) {
                   "glTF: fewest Draco position bits (default 14; more if the error budget needs them)");
   cmd->add_option("--normal-bits", args->options.budget.normal_bits, "glTF: Draco normal bits (default 10)");
   cmd->add_option("--min-texcoord-bits", args->options.budget.min_texcoord_bits,
-                  "glTF: fewest Draco texture-coordinate bits (default 12)");
+                  "glTF: Draco bits of arbitrary texture coordinates (default 12; texel-centre "
+                  "lattices take the fewest that hold them)");
   cmd->add_option("--cage", args->options.cage,
                   "also fit a Catmull-Clark cage with N x N quads per cube face (OUT_cage.obj) and sample "
                   "its displacement map (OUT_disp.exr); default 0: none");

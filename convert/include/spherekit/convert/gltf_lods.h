@@ -29,9 +29,14 @@
 // so the projected edge length stays within a factor of two; the last level is used down to
 // `lowest_coverage` (0: never culled).
 //
-// Provenance and quantization are recorded in extras: asset.extras.spherekit (toolkit and
-// format version, source mesh, sphere map, layout, texture coordinate convention) and, per
-// mesh, extras.spherekit (level, image size, quantization with its error budget).
+// Provenance and quantization are recorded in the combined file's extras: asset.extras.spherekit
+// (toolkit and format version, source mesh, sphere map, layout, texture coordinate convention)
+// and, per mesh, extras.spherekit (level, image size, quantization with its error budget). A
+// level's own file is kept minimal, since its size is what a viewer downloads and what is
+// compared against other tools: asset.extras.spherekit holds only "lod" and "texture_size"
+// (the T of TEXCOORD_0's texel centres), POSITION bounds are the shortest decimals of the
+// decoded floats, and no mesh extras (the level's quantization is in GltfLodLevel and the
+// convert report).
 #pragma once
 
 #include <string>
@@ -107,6 +112,12 @@ struct GltfLodOptions {
   /// step of about 2 err texels of the T x T geometry image, so a coordinate moves by about
   /// err texels at most (0.5 and T = 257: 8 bits, at most 0.502 texel).
   double texcoord_max_error_texels = 0.5;
+  /// Original: level k's texture coordinates get k bits fewer than level 0's (at least 4): its
+  /// edges are 2^k times as long and it is shown at most at 1/2^k of level 0's size (the screen
+  /// coverages halve per level), so the grid step stays the same fraction of its triangles and
+  /// the same distance on screen (half a texel of mip level k at T = 257 and 0.5 texel).
+  /// false: every level has level 0's bits.
+  bool coarse_texcoord_bits = true;
   std::string name = "mesh";    ///< node and mesh names: NAME_LOD0, NAME_LOD1, ...
   GltfProvenance provenance;
   // Effort

@@ -38,8 +38,12 @@ struct PositionBitsChoice {
 /// surface error without quantization; `gamma` in [0.5, 2]. The grid's origin and range stay
 /// `options.quantization`'s. Deterministic. Errors: InvalidArgument (level_error_rms <= 0,
 /// gamma outside [0.5, 2], min_bits outside 1..bits), and encode_draco_primitive's.
+/// `fixed_bytes`: bytes of the file around the bitstream (GLB headers, JSON), added to bytes(b)
+/// in J, since the file is what is downloaded; it tilts the choice towards more bits when the
+/// bitstream is small.
 [[nodiscard]] Result<PositionBitsChoice> choose_position_bits(const GltfMesh& mesh, const DracoEncodeOptions& options,
-                                                              double level_error_rms, double gamma, int min_bits);
+                                                              double level_error_rms, double gamma, int min_bits,
+                                                              double fixed_bytes = 0);
 
 /// gamma of the rate model from a model's finest and coarsest level: log(V0/V1) / log(e1/e0),
 /// clamped to [0.5, 2]; 1 when the levels do not determine it (equal counts or errors).

@@ -131,6 +131,10 @@ Result<ConvertMeshResult> convert_mesh(const ConvertMeshJob& job, const Progress
 Json to_json(const ConvertMeshResult& r);
 /// A cage's report object (file names as recorded in `c`).
 Json to_json(const CageAssets& c);
+/// A level of detail's quantization for the reports (the level files carry none of it):
+/// position bits, their largest error, the error they were chosen against and by what rule,
+/// texture-coordinate bits, and normal bits when the level has normals.
+Json lod_quantization_json(const convert::GltfLodLevel& level);
 
 /// OUT.exr -> OUT (the glTF files are OUT_lod0.glb ... and OUT_lods.glb).
 std::string output_prefix(const std::string& output);

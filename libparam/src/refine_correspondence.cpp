@@ -478,9 +478,11 @@ RowMat3d compose(const TriMesh& tmpl, const RowMat3d& St, const RowMat3d& Q, con
 // error does not grow). Holes are closed for the passes as the constrained stage closes
 // them (fill_holes, low-weight fan faces, each centre in its fan's kernel); a hole whose loop
 // is not star-shaped on the sphere (empty kernel) leaves the map unpolished (false).
-Result<bool> polish_stretch(const TriMesh& m, const std::vector<int>& feat, int passes,
+// `closed` is fill_holes of the member, made once per member.
+Result<bool> polish_stretch(const Result<FilledMesh>& closed, const std::vector<int>& feat, int passes,
                             const std::function<bool()>& keep_going, RowMat3d* S) {
-  SPHEREKIT_ASSIGN_OR_RETURN(const FilledMesh filled, fill_holes(m));
+  if (!closed.ok()) return closed.status();
+  const FilledMesh& filled = *closed;
   const TriMesh& c = filled.mesh;
   RowMat3d Sc(c.V.rows(), 3);
   Sc.topRows(S->rows()) = *S;
@@ -594,6 +596,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
         rep.efficiency_before = rep.efficiency_after = m0.efficiency;
         const double bar = std::min(m0.efficiency, template_efficiency);
         const VertexFaces mi_faces(mi);
+        const Result<FilledMesh> mi_closed = options.stretch_passes > 0 ? fill_holes(mi) : Result<FilledMesh>(FilledMesh{});
         const std::vector<int> spread = surface_samples(mi, fi, options.samples);
         int samples = options.samples;
         for (int round = 0; round < options.rounds; ++round) {
@@ -636,7 +639,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           for (int v : fi) S.row(v) = cur.row(v);
           if (options.stretch_passes > 0) {
             RowMat3d Sp = S;
-            const Result<bool> polished = polish_stretch(mi, fi, options.stretch_passes, keep_going, &Sp);
+            const Result<bool> polished = polish_stretch(mi_closed, fi, options.stretch_passes, keep_going, &Sp);
             if (!keep_going()) return Status(ErrorCode::Cancelled, "cancelled");
             if (polished.ok() && *polished) {
               S = std::move(Sp);

@@ -114,7 +114,7 @@ std::vector<int> passing_features(const std::vector<Eigen::Vector3d>& from, cons
 
 Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std::vector<int>& fv,
                                 const std::vector<Eigen::Vector3d>& targets, const ProgressFn& progress, RowMat3d* S,
-                                WarpStats* stats) {
+                                WarpStats* stats, const WarpRelaxFn& relax) {
   const int k = static_cast<int>(fv.size());
   if (static_cast<int>(targets.size()) != k) return Status(ErrorCode::InvalidArgument, "one target per feature is required");
   if (any_flipped(F, *S)) return Status(ErrorCode::SolverFailed, "feature warp: the start map is not bijective");
@@ -160,7 +160,25 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
   int steps = 0, rejected = 0;
   std::vector<Eigen::Vector3d> cur = start;
   Eigen::MatrixXd K(k, k), D(k, 3), C;
+  int relaxed = 0;
   while (t < 1) {
+    if (dt < 1.0 / 1024 && relax && relaxed < kMaxRelaxes) {
+      // The mesh between features has been squeezed below what a step can carry: let the
+      // stretch optimizer spread it out (features fixed where they are now), then go on.
+      ++relaxed;
+      RowMat3d R = *S;
+      const Status rs = relax(&R);
+      if (rs.code() == ErrorCode::Cancelled) {
+        *S = saved;
+        return rs;
+      }
+      if (rs.ok() && !any_flipped(F, R)) {
+        S->swap(R);
+        dt = 1.0 / 64;
+        continue;
+      }
+      relaxed = kMaxRelaxes;  // it did not help; the remedies below get their turn
+    }
     if (dt < 1.0 / 1024 && reshaped < kMaxReshapes) {
       // A face that flips however small the step is a sliver wider than the field's support
       // (left by the Steiner-vertex removal): reshape the faces around it against the mesh's
@@ -209,6 +227,7 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
         }
         std::sort(stats->culprits.begin(), stats->culprits.end());
         stats->culprits.erase(std::unique(stats->culprits.begin(), stats->culprits.end()), stats->culprits.end());
+        stats->relaxed = relaxed;
       }
       *S = saved;
       return Status(ErrorCode::SolverFailed, "feature warp: a face flips however small the step");
@@ -260,6 +279,7 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
     stats->steps = steps;
     stats->rejected = rejected;
     stats->reshaped = reshaped;
+    stats->relaxed = relaxed;
   }
   return Status();
 }

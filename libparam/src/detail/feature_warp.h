@@ -17,6 +17,7 @@
 // (WarpStats::culprits) join the network, which routes them by paths, on the right side.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -54,6 +55,7 @@ struct WarpStats {
   int steps = 0;     ///< accepted flow steps
   int rejected = 0;  ///< steps halved because a face flipped
   int reshaped = 0;  ///< slivers reshaped (untangle_patch) because they flipped at any step
+  int relaxed = 0;   ///< calls of the relax function
   std::vector<int> culprits;  ///< on failure: indices of the features nearest the faces that kept flipping
 };
 
@@ -68,8 +70,16 @@ struct WarpStats {
 /// moving features nearest each face that still flips).
 /// On success S has 0 flipped faces and every feature exactly on its target; otherwise
 /// SolverFailed and S unchanged. Deterministic (one thread).
+///
+/// `relax`, if given, is called on the current map when a step keeps flipping faces however
+/// small it gets: it must keep the map bijective and the features where they are (the
+/// constrained stage passes a few stretch-optimizer passes with the features fixed). The mesh
+/// squeezed between features that pass close to each other then spreads out again, and the
+/// flow goes on (at most kMaxRelaxes times).
+using WarpRelaxFn = std::function<Status(RowMat3d* S)>;
+constexpr int kMaxRelaxes = 12;
 Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std::vector<int>& fv,
                                 const std::vector<Eigen::Vector3d>& targets, const ProgressFn& progress, RowMat3d* S,
-                                WarpStats* stats = nullptr);
+                                WarpStats* stats = nullptr, const WarpRelaxFn& relax = {});
 
 }  // namespace spherekit::detail

@@ -161,8 +161,9 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
   std::vector<Eigen::Vector3d> cur = start;
   Eigen::MatrixXd K(k, k), D(k, 3), C;
   int relaxed = 0;
+  bool relax_failed = false;
   while (t < 1) {
-    if (dt < 1.0 / 1024 && relax && relaxed < kMaxRelaxes) {
+    if (dt < 1.0 / 1024 && relax && !relax_failed && relaxed < kMaxRelaxes) {
       // The mesh between features has been squeezed below what a step can carry: let the
       // stretch optimizer spread it out (features fixed where they are now), then go on.
       ++relaxed;
@@ -177,7 +178,7 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
         dt = 1.0 / 64;
         continue;
       }
-      relaxed = kMaxRelaxes;  // it did not help; the remedies below get their turn
+      relax_failed = true;  // it did not help; the remedies below get their turn
     }
     if (dt < 1.0 / 1024 && reshaped < kMaxReshapes) {
       // A face that flips however small the step is a sliver wider than the field's support

@@ -73,7 +73,7 @@ struct WarpStats {
 ///
 /// `relax`, if given, is called on the current map when a step keeps flipping faces however
 /// small it gets: it must keep the map bijective and the features where they are (the
-/// constrained stage passes a few stretch-optimizer passes with the features fixed). The mesh
+/// constrained stage passes one stretch-optimizer pass with the features fixed). The mesh
 /// squeezed between features that pass close to each other then spreads out again, and the
 /// flow goes on (at most kMaxRelaxes times).
 using WarpRelaxFn = std::function<Status(RowMat3d* S)>;

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <queue>
 #include <string>
 
@@ -38,6 +39,75 @@ struct HeapGreater {
     if (a.vt != b.vt) return a.vt > b.vt;  // ties broken by ids: deterministic
     return a.vs > b.vs;
   }
+};
+
+// Min-heap of vertices keyed by each one's cheapest untried collapse, with positions, so a
+// key can change in place (memoryless quadrics: see Simplifier::refresh).
+class VertexHeap {
+ public:
+  void reset(int nv) {
+    pos_.assign(static_cast<size_t>(nv), -1);
+    heap_.clear();
+  }
+  bool empty() const { return heap_.empty(); }
+  int top() const { return heap_.front(); }
+  // Inserts v, or moves it to its new key's place.
+  template <class Key>
+  void update(int v, const Key& key) {
+    int i = pos_[static_cast<size_t>(v)];
+    if (i < 0) {
+      i = static_cast<int>(heap_.size());
+      heap_.push_back(v);
+      pos_[static_cast<size_t>(v)] = i;
+    }
+    sift_down(sift_up(i, key), key);
+  }
+  template <class Key>
+  void remove(int v, const Key& key) {
+    const int i = pos_[static_cast<size_t>(v)];
+    if (i < 0) return;
+    pos_[static_cast<size_t>(v)] = -1;
+    const int last = heap_.back();
+    heap_.pop_back();
+    if (last == v) return;
+    heap_[static_cast<size_t>(i)] = last;
+    pos_[static_cast<size_t>(last)] = i;
+    sift_down(sift_up(i, key), key);
+  }
+
+ private:
+  template <class Key>
+  int sift_up(int i, const Key& key) {
+    const int v = heap_[static_cast<size_t>(i)];
+    while (i > 0) {
+      const int parent = (i - 1) / 2;
+      if (!HeapGreater()(key(heap_[static_cast<size_t>(parent)]), key(v))) break;
+      place(i, heap_[static_cast<size_t>(parent)]);
+      i = parent;
+    }
+    place(i, v);
+    return i;
+  }
+  template <class Key>
+  void sift_down(int i, const Key& key) {
+    const int n = static_cast<int>(heap_.size());
+    const int v = heap_[static_cast<size_t>(i)];
+    for (;;) {
+      int child = 2 * i + 1;
+      if (child >= n) break;
+      if (child + 1 < n && HeapGreater()(key(heap_[static_cast<size_t>(child)]), key(heap_[static_cast<size_t>(child) + 1])))
+        ++child;
+      if (!HeapGreater()(key(v), key(heap_[static_cast<size_t>(child)]))) break;
+      place(i, heap_[static_cast<size_t>(child)]);
+      i = child;
+    }
+    place(i, v);
+  }
+  void place(int i, int v) {
+    heap_[static_cast<size_t>(i)] = v;
+    pos_[static_cast<size_t>(v)] = i;
+  }
+  std::vector<int> heap_, pos_;
 };
 
 // Below this triangle quality a collapse may not make things worse (a quality-0.02 triangle
@@ -94,12 +164,20 @@ class Simplifier {
     while (alive_count_ > target) {
       rebuild_heap();
       int collapsed_this_round = 0;
-      while (alive_count_ > target && !heap_.empty()) {
-        HeapEntry e = heap_.top();
-        heap_.pop();
-        if (!vertex_alive_[e.vt] || !vertex_alive_[e.vs]) continue;
-        if (e.stamp_t != stamp_[e.vt] || e.stamp_s != stamp_[e.vs]) continue;
-        if (!collapse_if_legal(e.vt, e.vs, forced, pm)) continue;
+      while (alive_count_ > target && (opt_.memoryless ? !vheap_.empty() : !heap_.empty())) {
+        if (opt_.memoryless) {
+          const int vt = vheap_.top();
+          const int vs = best_[static_cast<size_t>(vt)].vs;
+          if (!collapse_if_legal(vt, vs, forced, pm)) {
+            drop_candidate(vt, vs);
+            continue;
+          }
+        } else {
+          HeapEntry e = heap_.top();
+          heap_.pop();
+          if (!live(e)) continue;
+          if (!collapse_if_legal(e.vt, e.vs, forced, pm)) continue;
+        }
         ++collapsed_this_round;
         int done = nv_ - alive_count_;
         int pct = static_cast<int>(100.0 * done / total);
@@ -216,29 +294,88 @@ class Simplifier {
     return pn.size() == 2 && (pn[0] == vs || pn[1] == vs);
   }
 
+  // Pushes the collapse vt -> vs, if vt may move at all.
+  void push_half_edge(int vt, int vs) {
+    const bool keep = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(vt)];
+    if (!keep && path_allows(vt, vs)) heap_.push({cost(vt, vs), vt, vs, stamp_[vt], stamp_[vs]});
+  }
   void push_edge(int a, int b) {
-    bool keep_a = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(a)];
-    bool keep_b = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(b)];
-    if (!keep_a && path_allows(a, b)) heap_.push({cost(a, b), a, b, stamp_[a], stamp_[b]});
-    if (!keep_b && path_allows(b, a)) heap_.push({cost(b, a), b, a, stamp_[b], stamp_[a]});
+    push_half_edge(a, b);
+    push_half_edge(b, a);
   }
 
-  // Drops the entries made stale by later collapses (memoryless quadrics re-push a 2-ring per
-  // collapse, so most entries go stale): peak memory stays proportional to the live edges.
+  // Is an entry of the lazy heap (accumulated quadrics) still current?
+  bool live(const HeapEntry& e) const {
+    return vertex_alive_[e.vt] && vertex_alive_[e.vs] && e.stamp_t == stamp_[e.vt] && e.stamp_s == stamp_[e.vs];
+  }
+
+  // Memoryless quadrics: the cost of vt -> vs reads only vt's faces, vt's area, vs's (fixed)
+  // position and whether vt may move towards vs, which change only for the vertices of a
+  // collapse's ring. So each vertex keeps its outgoing collapses' costs (refreshed when its
+  // ring changes) and sits in a vertex heap under its cheapest one not yet found illegal.
+  // Popping the heap gives the same (cost, vt, vs) order as a heap of every half-edge with
+  // stale entries skipped, the same collapses, at a sixth of the heap traffic (the lazy
+  // heap spent most of the simplification's time on cache misses of its stale entries).
+  struct Candidate {
+    double cost;
+    int vs;
+  };
+  void refresh(int vt) {
+    auto& list = cand_[static_cast<size_t>(vt)];
+    list.clear();
+    const bool keep = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(vt)];
+    if (!keep) {
+      neighbours(vt, ring_);
+      for (int vs : ring_)
+        if (path_allows(vt, vs)) list.push_back({cost(vt, vs), vs});
+    }
+    choose_best(vt);
+  }
+  void drop_candidate(int vt, int vs) {
+    auto& list = cand_[static_cast<size_t>(vt)];
+    for (size_t i = 0; i < list.size(); ++i)
+      if (list[i].vs == vs) {
+        list.erase(list.begin() + static_cast<std::ptrdiff_t>(i));
+        break;
+      }
+    choose_best(vt);
+  }
+  void choose_best(int vt) {
+    const auto& list = cand_[static_cast<size_t>(vt)];
+    HeapEntry best{kInfCost, vt, -1, 0, 0};
+    for (const Candidate& c : list) {
+      const HeapEntry e{c.cost, vt, c.vs, 0, 0};
+      if (best.vs < 0 || HeapGreater()(best, e)) best = e;
+    }
+    best_[static_cast<size_t>(vt)] = best;
+    auto key = [this](int v) -> const HeapEntry& { return best_[static_cast<size_t>(v)]; };
+    if (best.vs < 0 || !vertex_alive_[vt]) vheap_.remove(vt, key);
+    else vheap_.update(vt, key);
+  }
+
+  // Drops the lazy heap's entries made stale by later collapses: peak memory stays
+  // proportional to the live edges.
   // The pop order is a total order on (cost, vt, vs), so the collapses are unchanged.
   void compact_heap() {
-    std::vector<HeapEntry> live;
+    std::vector<HeapEntry> current;
     while (!heap_.empty()) {
       const HeapEntry& e = heap_.top();
-      if (vertex_alive_[e.vt] && vertex_alive_[e.vs] && e.stamp_t == stamp_[e.vt] && e.stamp_s == stamp_[e.vs])
-        live.push_back(e);
+      if (live(e)) current.push_back(e);
       heap_.pop();
     }
-    heap_ = decltype(heap_)(HeapGreater(), std::move(live));
+    heap_ = decltype(heap_)(HeapGreater(), std::move(current));
     compact_at_ = std::max<size_t>(65536, 2 * heap_.size());
   }
 
   void rebuild_heap() {
+    if (opt_.memoryless) {
+      cand_.resize(static_cast<size_t>(nv_));
+      best_.resize(static_cast<size_t>(nv_));
+      vheap_.reset(nv_);
+      for (int v = 0; v < nv_; ++v)
+        if (vertex_alive_[v]) refresh(v);
+      return;
+    }
     heap_ = decltype(heap_)();
     for (size_t f = 0; f < faces_.size(); ++f) {
       if (!face_alive_[f]) continue;
@@ -361,17 +498,16 @@ class Simplifier {
     pm.collapses.push_back(rec);
     neighbours(vs, ns_);
     if (opt_.memoryless) {
-      // The faces of vs's neighbours changed too: so did the costs of all their edges.
-      for (int w : ns_) ++stamp_[w];
-      std::vector<int> ring;
-      for (int w : ns_) {
-        neighbours(w, ring);
-        for (int x : ring) push_edge(w, x);
-      }
+      // The faces of vs's neighbours changed too: so did the costs of all their collapses.
+      auto key = [this](int v) -> const HeapEntry& { return best_[static_cast<size_t>(v)]; };
+      vheap_.remove(vt, key);
+      cand_[static_cast<size_t>(vt)].clear();
+      refresh(vs);
+      for (int w : ns_) refresh(w);
     } else {
       for (int w : ns_) push_edge(vs, w);
     }
-    if (heap_.size() > compact_at_) compact_heap();
+    if (!opt_.memoryless && heap_.size() > compact_at_) compact_heap();
     return true;
   }
 
@@ -387,9 +523,13 @@ class Simplifier {
   std::vector<std::uint32_t> stamp_;
   std::vector<detail::QuadricND> quadric_;
   std::vector<double> area_;
-  std::vector<int> nt_, ns_;
+  std::vector<int> nt_, ns_, ring_;
   std::vector<std::vector<int>> path_nbr_;  // per vertex: its neighbours along path edges
-  std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;
+  std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;  // accumulated quadrics
+  std::vector<std::vector<Candidate>> cand_;  // memoryless: per vertex, its collapses' costs
+  std::vector<HeapEntry> best_;               // memoryless: per vertex, its cheapest candidate
+  VertexHeap vheap_;
+  static constexpr double kInfCost = std::numeric_limits<double>::infinity();
   size_t compact_at_ = 65536;  // heap size that triggers compact_heap
 };
 

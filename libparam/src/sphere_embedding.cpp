@@ -128,17 +128,32 @@ class Refiner {
     if (total > 0) SPHEREKIT_RETURN_IF_ERROR(optimize_level());
     int threshold = next_threshold(st_.alive_vertices);
     int last_pct = -1;
-    for (int i = total - 1; i >= 0; --i) {
-      apply_split(i);
-      SPHEREKIT_RETURN_IF_ERROR(place_new_vertex(i));
+    region_mark_.assign(static_cast<size_t>(pm_.num_vertices), 0);
+    seen_mark_.assign(static_cast<size_t>(pm_.num_vertices), 0);
+    rings_.resize(static_cast<size_t>(pool_.threads()));
+    for (int i = total - 1; i >= 0;) {
+      // The splits are replayed in order; a run of consecutive splits whose regions are
+      // disjoint (split_region) commute, so they are applied first and their new vertices
+      // placed in parallel: the same positions as one split after another, for any number
+      // of threads (the run's extent depends on the mesh only).
+      batch_.clear();
+      ++region_stamp_;
+      while (i >= 0 && batch_.size() < kMaxBatch) {
+        if (!claim_split_region(i)) break;
+        apply_split(i);
+        batch_.push_back(i);
+        --i;
+        if (st_.alive_vertices >= threshold) break;
+      }
+      SPHEREKIT_RETURN_IF_ERROR(place_batch());
       if (st_.alive_vertices >= threshold) {
         SPHEREKIT_RETURN_IF_ERROR(optimize_level());
         threshold = next_threshold(st_.alive_vertices);
       }
-      int pct = static_cast<int>(100.0 * (total - i) / std::max(1, total));
+      int pct = static_cast<int>(100.0 * (total - 1 - i) / std::max(1, total));
       if (pct != last_pct) {
         last_pct = pct;
-        if (!report_progress(progress_, "refine", st_.alive_vertices, static_cast<double>(total - i) / std::max(1, total)))
+        if (!report_progress(progress_, "refine", st_.alive_vertices, static_cast<double>(total - 1 - i) / std::max(1, total)))
           return Status(ErrorCode::Cancelled, "cancelled during refinement");
       }
     }
@@ -248,42 +263,95 @@ class Refiner {
     }
   }
 
-  Status place_new_vertex(int i) {
+  // Split i's region: the vertices within `radius` of vs before the split, and vt. Placing vt
+  // reads vt's faces and its neighbours' positions and writes vt (radius 1); with neighbour
+  // moves (vsplit_nei_iter) it reads vt's 2-ring and writes its 1-ring (radius 2). After the
+  // split, vt's k-ring lies in vs's closed k-ring before it plus vt, and the split itself
+  // changes only faces and face lists of vertices in vt's closed 1-ring. So two splits with
+  // disjoint regions neither read nor write anything of each other's. Returns false (and
+  // marks nothing) if split i's region meets one claimed since the last stamp; the first
+  // split of a run always gets its region.
+  bool claim_split_region(int i) {
+    const auto& c = pm_.collapses[static_cast<size_t>(i)];
+    const int radius = s_.vsplit_nei_iter > 0 ? 2 : 1;
+    ++seen_stamp_;
+    region_.clear();
+    auto add = [&](int v) {
+      if (seen_mark_[static_cast<size_t>(v)] == seen_stamp_) return;
+      seen_mark_[static_cast<size_t>(v)] = seen_stamp_;
+      region_.push_back(v);
+    };
+    add(c.vt);
+    add(c.vs);
+    size_t begin = 1;
+    for (int r = 0; r < radius; ++r) {
+      const size_t end = region_.size();
+      for (size_t k = begin; k < end; ++k)
+        for (int f : st_.vf[static_cast<size_t>(region_[k])])
+          for (int w : st_.F[static_cast<size_t>(f)]) add(w);
+      begin = end;
+    }
+    if (!batch_.empty())
+      for (int v : region_)
+        if (region_mark_[static_cast<size_t>(v)] == region_stamp_) return false;
+    for (int v : region_) region_mark_[static_cast<size_t>(v)] = region_stamp_;
+    return true;
+  }
+
+  // Places the new vertices of the splits in batch_ (already applied), in parallel; the
+  // first failure in split order is returned.
+  Status place_batch() {
+    const int n = static_cast<int>(batch_.size());
+    placed_.assign(static_cast<size_t>(n), 0);
+    pool_.parallel_for(n, 1, 2, [&](int j, int thread) {
+      placed_[static_cast<size_t>(j)] = place_new_vertex(batch_[static_cast<size_t>(j)], rings_[static_cast<size_t>(thread)]);
+    });
+    for (int j = 0; j < n; ++j) {
+      if (placed_[static_cast<size_t>(j)] == 0)
+        return Status(ErrorCode::SolverFailed,
+                      "could not place vertex " + std::to_string(pm_.collapses[static_cast<size_t>(batch_[static_cast<size_t>(j)])].vt) +
+                          " inside its spherical kernel");
+      if (placed_[static_cast<size_t>(j)] == 2) ++stats_->fallback_placements;
+    }
+    return Status();
+  }
+
+  // Returns 0 if vt could not be placed, 1 if placed at the kernel centroid, 2 by a fallback.
+  int place_new_vertex(int i, RingScratch& ring) {
+    int result = 1;
     const int vt = pm_.collapses[static_cast<size_t>(i)].vt;
-    load_ring(st_, vt, ring_);
+    load_ring(st_, vt, ring);
     Eigen::Vector3d x;
-    bool ok = kernel_centroid(ring_, &x) && ring_valid_exact(ring_, x);
+    bool ok = kernel_centroid(ring, &x) && ring_valid_exact(ring, x);
     if (!ok) {
-      ++stats_->fallback_placements;
+      result = 2;
       Eigen::Vector3d start = st_.S.row(pm_.collapses[static_cast<size_t>(i)].vs).transpose();
       Eigen::Vector3d c;
-      if (kernel_centroid(ring_, &c)) start = c;
-      ok = kernel_chebyshev(ring_, start, &x) ||
-           kernel_near_vertex(ring_, st_.S.row(pm_.collapses[static_cast<size_t>(i)].vs).transpose(), &x);
+      if (kernel_centroid(ring, &c)) start = c;
+      ok = kernel_chebyshev(ring, start, &x) ||
+           kernel_near_vertex(ring, st_.S.row(pm_.collapses[static_cast<size_t>(i)].vs).transpose(), &x);
     }
-    if (!ok)
-      return Status(ErrorCode::SolverFailed,
-                    "could not place vertex " + std::to_string(vt) + " inside its spherical kernel");
+    if (!ok) return 0;
     st_.S.row(vt) = x.transpose();
     std::uint64_t key = s_.seed * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(i);
     for (int k = 0; k < s_.vsplit_vt_iter; ++k) {
       Eigen::Vector3d y;
-      if (optimize_vertex(st_, vt, key + static_cast<std::uint64_t>(k) * 7919, s_, ring_, &y, 2))
+      if (optimize_vertex(st_, vt, key + static_cast<std::uint64_t>(k) * 7919, s_, ring, &y, 2))
         st_.S.row(vt) = y.transpose();
     }
     if (s_.vsplit_nei_iter > 0) {
-      load_ring(st_, vt, ring_);
+      load_ring(st_, vt, ring);
       std::vector<int> nbrs;
-      for (const auto& rf : ring_.faces) nbrs.push_back(rf.a);
+      for (const auto& rf : ring.faces) nbrs.push_back(rf.a);
       for (int k = 0; k < s_.vsplit_nei_iter; ++k)
         for (int w : nbrs) {
           if (!st_.fixed.empty() && st_.fixed[static_cast<size_t>(w)]) continue;
           Eigen::Vector3d y;
-          if (optimize_vertex(st_, w, key ^ (static_cast<std::uint64_t>(w) << 20) ^ static_cast<std::uint64_t>(k), s_, ring_, &y, 2))
+          if (optimize_vertex(st_, w, key ^ (static_cast<std::uint64_t>(w) << 20) ^ static_cast<std::uint64_t>(k), s_, ring, &y, 2))
             st_.S.row(w) = y.transpose();
         }
     }
-    return Status();
+    return result;
   }
 
   Status optimize_level() { return optimize_level(s_); }
@@ -328,7 +396,12 @@ class Refiner {
   const ProgressFn& progress_;
   EmbedStats* stats_;
   SphereState st_;
-  RingScratch ring_;
+  std::vector<RingScratch> rings_;  // one per thread
+  static constexpr size_t kMaxBatch = 256;
+  std::vector<int> batch_, region_;
+  std::vector<char> placed_;
+  std::vector<std::uint32_t> region_mark_, seen_mark_;  // stamps: claimed by the run; in region_
+  std::uint32_t region_stamp_ = 0, seen_stamp_ = 0;
   std::vector<char> hole_vertex_;  // corners of the faces that close holes, at full resolution
   WorkerPool pool_;  // one set of threads for every pass of the run
 };

@@ -124,6 +124,17 @@ TEST_CASE("results are deterministic, also across thread counts", "[param][spher
   REQUIRE(c.ok());
   CHECK(a->map.S == b->map.S);  // bitwise equality
   CHECK(a->map.S == c->map.S);
+  // Effort 3 also moves each new vertex's neighbours (the vertex splits placed in parallel
+  // then claim 2-rings); three threads split the runs of splits differently again.
+  one.effort = 3;
+  SphereParamOptions three = one;
+  three.threads = 3;
+  auto d = parameterize_sphere(m, one);
+  auto e = parameterize_sphere(m, three);
+  REQUIRE(d.ok());
+  REQUIRE(e.ok());
+  CHECK(d->map.S == e->map.S);
+  CHECK(d->map.S != a->map.S);  // the effort did change the map
 }
 
 TEST_CASE("progress callback can cancel", "[param][sphere]") {

@@ -19,6 +19,7 @@
 // round form an independent set (no two moved vertices share a face), so every face has at
 // most one moving corner and the per-vertex checks are sufficient.
 #include <algorithm>
+#include <span>
 #include <cmath>
 #include <limits>
 
@@ -556,6 +557,28 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   };
   WorkerPool serial(1);
   WorkerPool& workers = pool ? *pool : serial;
+  // Each alive vertex's face-walk corners (for f around v, the two other corners of f, in
+  // vf order): the rounds below visit neighbours in exactly this order, from one contiguous
+  // list instead of a face list and the faces' corners (cache misses, on the calling thread).
+  std::vector<int> walk_start(static_cast<size_t>(nv) + 1, 0), walk;
+  for (int v = 0; v < nv; ++v)
+    walk_start[static_cast<size_t>(v) + 1] =
+        walk_start[static_cast<size_t>(v)] +
+        (st.vertex_alive[static_cast<size_t>(v)] ? 2 * static_cast<int>(st.vf[static_cast<size_t>(v)].size()) : 0);
+  walk.resize(static_cast<size_t>(walk_start.back()));
+  workers.parallel_for(nv, 256, 1024, [&](int v, int) {
+    if (!st.vertex_alive[static_cast<size_t>(v)]) return;
+    int* out = walk.data() + walk_start[static_cast<size_t>(v)];
+    for (int f : st.vf[static_cast<size_t>(v)])
+      for (int k = 0; k < 3; ++k) {
+        const int w = st.F[static_cast<size_t>(f)][k];
+        if (w != v) *out++ = w;
+      }
+  });
+  auto corners = [&](int v) {
+    return std::span<const int>(walk.data() + walk_start[static_cast<size_t>(v)],
+                                walk.data() + walk_start[static_cast<size_t>(v) + 1]);
+  };
   std::vector<RingScratch> rings(static_cast<size_t>(workers.threads()));
   std::vector<Candidate> cand;
   // Per-vertex marks instead of arrays cleared every round: a round costs time in
@@ -571,11 +594,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
     if (s.movetol_rel > 0) {
       double shortest = kInf;
       const Eigen::Vector3d x = st.S.row(v).transpose();
-      for (int f : st.vf[static_cast<size_t>(v)])
-        for (int k = 0; k < 3; ++k) {
-          const int w = st.F[static_cast<size_t>(f)][k];
-          if (w != v) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
-        }
+      for (int w : corners(v)) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
       tol = std::min(s.movetol, s.movetol_rel * shortest);
     }
     return tol;
@@ -614,13 +633,10 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       for (int i = 0; i < na; ++i) {
         const int v = active[static_cast<size_t>(i)];
         std::uint64_t used = 0;
-        for (int f : st.vf[static_cast<size_t>(v)])
-          for (int k = 0; k < 3; ++k) {
-            const int w = st.F[static_cast<size_t>(f)][k];
-            if (w != v && listed_in[static_cast<size_t>(w)] == round && colour_of[static_cast<size_t>(w)] >= 0 &&
-                colour_of[static_cast<size_t>(w)] < 64)
-              used |= std::uint64_t{1} << colour_of[static_cast<size_t>(w)];
-          }
+        for (int w : corners(v))
+          if (listed_in[static_cast<size_t>(w)] == round && colour_of[static_cast<size_t>(w)] >= 0 &&
+              colour_of[static_cast<size_t>(w)] < 64)
+            used |= std::uint64_t{1} << colour_of[static_cast<size_t>(w)];
         int c = 0;
         while (c < 64 && (used >> c & 1)) ++c;  // > 63 coloured neighbours: impossible in practice, 64 is safe
         colour_of[static_cast<size_t>(v)] = c;
@@ -641,7 +657,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       for (int c = 0; c < ncol; ++c) {
         const int* cls = order.data() + class_start[static_cast<size_t>(c)];
         const int count = class_start[static_cast<size_t>(c) + 1] - class_start[static_cast<size_t>(c)];
-        workers.parallel_for(count, 16, 64, [&](int j, int thread) { compute_candidate(cls[j], round, thread); });
+        workers.parallel_for(count, 4, 8, [&](int j, int thread) { compute_candidate(cls[j], round, thread); });
         for (int j = 0; j < count; ++j) {
           const int i = cls[j];
           const int v = active[static_cast<size_t>(i)];
@@ -649,16 +665,13 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
           const Candidate& cd = cand[static_cast<size_t>(i)];
           if (!cd.moved) continue;
           st.S.row(v) = cd.x.transpose();
-          for (int f : st.vf[static_cast<size_t>(v)])
-            for (int k = 0; k < 3; ++k) {
-              const int w = st.F[static_cast<size_t>(f)][k];
-              if (w == v) continue;
-              credit[static_cast<size_t>(w)] += 0.3 * cd.dist / 2.0;
-              if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {
-                listed_in[static_cast<size_t>(w)] = round;
-                next.push_back(w);
-              }
+          for (int w : corners(v)) {
+            credit[static_cast<size_t>(w)] += 0.3 * cd.dist / 2.0;
+            if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {
+              listed_in[static_cast<size_t>(w)] = round;
+              next.push_back(w);
             }
+          }
         }
       }
       keep.assign(next.size(), 0);
@@ -697,18 +710,15 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       if (locked_in[static_cast<size_t>(v)] == round) continue;  // a neighbour moved: retry next round
       credit[static_cast<size_t>(v)] = 0;
       st.S.row(v) = cand[static_cast<size_t>(i)].x.transpose();
-      for (int f : st.vf[static_cast<size_t>(v)])
-        for (int k = 0; k < 3; ++k) {
-          const int w = st.F[static_cast<size_t>(f)][k];
-          if (w == v) continue;
-          locked_in[static_cast<size_t>(w)] = round;
-          // "Spatial fade": neighbours of a moved vertex gain credit (REFERENCE.md §2.5).
-          credit[static_cast<size_t>(w)] += 0.3 * cand[static_cast<size_t>(i)].dist / 2.0;
-          if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {
-            listed_in[static_cast<size_t>(w)] = round;
-            next.push_back(w);  // may have gained enough credit
-          }
+      for (int w : corners(v)) {
+        locked_in[static_cast<size_t>(w)] = round;
+        // "Spatial fade": neighbours of a moved vertex gain credit (REFERENCE.md §2.5).
+        credit[static_cast<size_t>(w)] += 0.3 * cand[static_cast<size_t>(i)].dist / 2.0;
+        if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {
+          listed_in[static_cast<size_t>(w)] = round;
+          next.push_back(w);  // may have gained enough credit
         }
+      }
     }
     for (int i = 0; i < na; ++i) {
       const int v = active[static_cast<size_t>(i)];

@@ -53,13 +53,19 @@ class WorkerPool {
       n_ = n;
       chunk_ = std::max(1, chunk);
       next_.store(0);
-      busy_ = static_cast<int>(workers_.size());
+      open_ = true;
+      joined_ = 0;
       ++generation_;
     }
     start_cv_.notify_all();
     run_chunks(0);
+    // Wait only for the workers that joined while the loop was open: they are running
+    // chunks now. One still waking up (tens of microseconds on a virtual machine, longer
+    // than many of the optimizer's loops) finds the loop closed and goes back to sleep, so
+    // its wake-up is never on the caller's path.
     std::unique_lock<std::mutex> lock(mutex_);
-    done_cv_.wait(lock, [&] { return busy_ == 0; });
+    open_ = false;
+    done_cv_.wait(lock, [&] { return joined_ == 0; });
     body_ = nullptr;
   }
 
@@ -82,11 +88,13 @@ class WorkerPool {
         start_cv_.wait(lock, [&] { return stop_ || generation_ != seen; });
         if (stop_) return;
         seen = generation_;
+        if (!open_) continue;  // the caller has finished this loop without us
+        ++joined_;
       }
       run_chunks(thread);
       {
         std::lock_guard<std::mutex> lock(mutex_);
-        --busy_;
+        --joined_;
       }
       done_cv_.notify_one();
     }
@@ -96,10 +104,10 @@ class WorkerPool {
   std::mutex mutex_;
   std::condition_variable start_cv_, done_cv_;
   const std::function<void(int, int)>* body_ = nullptr;
-  int n_ = 0, chunk_ = 1, busy_ = 0;
+  int n_ = 0, chunk_ = 1, joined_ = 0;  // joined_: workers running the open loop
   std::atomic<int> next_{0};
   unsigned long generation_ = 0;
-  bool stop_ = false;
+  bool stop_ = false, open_ = false;
 };
 
 }  // namespace spherekit::detail

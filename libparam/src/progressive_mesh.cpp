@@ -325,11 +325,66 @@ class Simplifier {
     list.clear();
     const bool keep = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(vt)];
     if (!keep) {
-      neighbours(vt, ring_);
+      // Neighbours in face-walk order (the candidates' order does not matter: the cheapest
+      // is chosen by the total order of (cost, vs)), without the sort of neighbours().
+      ring_.clear();
+      ++mark_stamp_;
+      mark_[static_cast<size_t>(vt)] = mark_stamp_;
+      for (int f : vf_[vt])
+        for (int w : faces_[f])
+          if (mark_[static_cast<size_t>(w)] != mark_stamp_) {
+            mark_[static_cast<size_t>(w)] = mark_stamp_;
+            ring_.push_back(w);
+          }
+      prepare_memoryless(vt);
       for (int vs : ring_)
-        if (path_allows(vt, vs)) list.push_back({cost(vt, vs), vs});
+        if (path_allows(vt, vs)) list.push_back({memoryless_cost(vt, vs), vs});
     }
     choose_best(vt);
+  }
+
+  // memoryless_error's per-face terms that do not depend on vs (the edge Gram matrix and
+  // the area), once per refresh instead of once per (face, vs): the same operations in the
+  // same order, so the same costs to the bit.
+  struct PlaneTerm {
+    const double *x0, *x1, *x2;
+    double e1e1, e1e2, e2e2, det, area;
+  };
+  void prepare_memoryless(int vt) {
+    planes_.clear();
+    const int d = qd_;
+    for (int f : vf_[vt]) {
+      const auto& c = faces_[f];
+      PlaneTerm t{X_.row(c[0]).data(), X_.row(c[1]).data(), X_.row(c[2]).data(), 0, 0, 0, 0, 0};
+      for (int i = 0; i < d; ++i) {
+        const double e1 = t.x1[i] - t.x0[i], e2 = t.x2[i] - t.x0[i];
+        t.e1e1 += e1 * e1, t.e1e2 += e1 * e2, t.e2e2 += e2 * e2;
+      }
+      t.det = t.e1e1 * t.e2e2 - t.e1e2 * t.e1e2;
+      if (!(t.det > 1e-24 * t.e1e1 * t.e2e2)) continue;
+      t.area = face_area(c);
+      planes_.push_back(t);
+    }
+  }
+  // cost(vt, vs) with memoryless quadrics, from prepare_memoryless(vt).
+  double memoryless_cost(int vt, int vs) const {
+    const int d = qd_;
+    const double* x = X_.row(vs).data();
+    double sum = 0;
+    for (const PlaneTerm& t : planes_) {
+      double re1 = 0, re2 = 0, rr = 0;
+      for (int i = 0; i < d; ++i) {
+        const double e1 = t.x1[i] - t.x0[i], e2 = t.x2[i] - t.x0[i], r = x[i] - t.x0[i];
+        re1 += r * e1, re2 += r * e2, rr += r * r;
+      }
+      const double proj = (t.e2e2 * re1 * re1 - 2 * t.e1e2 * re1 * re2 + t.e1e1 * re2 * re2) / t.det;
+      sum += t.area * std::max(0.0, rr - proj);
+    }
+    const double* ps = P_.row(vs).data();
+    const double* pt = P_.row(vt).data();
+    double len2 = 0;
+    for (int i = 0; i < d_; ++i) len2 += (ps[i] - pt[i]) * (ps[i] - pt[i]);
+    return sum + opt_.edge_length_weight * len2 * area_[vt];
   }
   void drop_candidate(int vt, int vs) {
     auto& list = cand_[static_cast<size_t>(vt)];
@@ -369,6 +424,8 @@ class Simplifier {
 
   void rebuild_heap() {
     if (opt_.memoryless) {
+      mark_.assign(static_cast<size_t>(nv_), 0);
+      mark_stamp_ = 0;
       cand_.resize(static_cast<size_t>(nv_));
       best_.resize(static_cast<size_t>(nv_));
       vheap_.reset(nv_);
@@ -524,6 +581,9 @@ class Simplifier {
   std::vector<detail::QuadricND> quadric_;
   std::vector<double> area_;
   std::vector<int> nt_, ns_, ring_;
+  std::vector<PlaneTerm> planes_;  // prepare_memoryless
+  std::vector<std::uint32_t> mark_;  // refresh: stamp of the vertices already listed
+  std::uint32_t mark_stamp_ = 0;
   std::vector<std::vector<int>> path_nbr_;  // per vertex: its neighbours along path edges
   std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;  // accumulated quadrics
   std::vector<std::vector<Candidate>> cand_;  // memoryless: per vertex, its collapses' costs

@@ -136,17 +136,18 @@ class Simplifier {
     }
     vertex_alive_.assign(static_cast<size_t>(nv_), 1);
     stamp_.assign(static_cast<size_t>(nv_), 0);
-    quadric_.assign(static_cast<size_t>(nv_), detail::QuadricND(qd_));
+    // Accumulated quadrics only where they are read (memoryless costs measure the current faces).
+    if (!opt_.memoryless) quadric_.assign(static_cast<size_t>(nv_), detail::QuadricND(qd_));
     area_.assign(static_cast<size_t>(nv_), 0.0);
     for (int f = 0; f < nf; ++f) {
       double w = opt_.face_weights.empty() ? 1.0 : opt_.face_weights[static_cast<size_t>(f)];
       double area = face_area(faces_[f]) * w;
-      detail::QuadricND q(qd_);
-      q.add_triangle(X_.row(F(f, 0)).data(), X_.row(F(f, 1)).data(), X_.row(F(f, 2)).data(), area);
-      for (int k = 0; k < 3; ++k) {
-        quadric_[static_cast<size_t>(F(f, k))].add(q);
-        area_[static_cast<size_t>(F(f, k))] += area / 3.0;
+      if (!opt_.memoryless) {
+        detail::QuadricND q(qd_);
+        q.add_triangle(X_.row(F(f, 0)).data(), X_.row(F(f, 1)).data(), X_.row(F(f, 2)).data(), area);
+        for (int k = 0; k < 3; ++k) quadric_[static_cast<size_t>(F(f, k))].add(q);
       }
+      for (int k = 0; k < 3; ++k) area_[static_cast<size_t>(F(f, k))] += area / 3.0;
     }
     alive_count_ = nv_;
     path_nbr_.resize(static_cast<size_t>(nv_));
@@ -323,6 +324,7 @@ class Simplifier {
   void refresh(int vt) {
     auto& list = cand_[static_cast<size_t>(vt)];
     list.clear();
+    dropped_[static_cast<size_t>(vt)] = 0;
     const bool keep = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(vt)];
     if (!keep) {
       // Neighbours in face-walk order (the candidates' order does not matter: the cheapest
@@ -388,6 +390,7 @@ class Simplifier {
   }
   void drop_candidate(int vt, int vs) {
     auto& list = cand_[static_cast<size_t>(vt)];
+    dropped_[static_cast<size_t>(vt)] = 1;
     for (size_t i = 0; i < list.size(); ++i)
       if (list[i].vs == vs) {
         list.erase(list.begin() + static_cast<std::ptrdiff_t>(i));
@@ -425,6 +428,7 @@ class Simplifier {
   void rebuild_heap() {
     if (opt_.memoryless) {
       mark_.assign(static_cast<size_t>(nv_), 0);
+      dropped_.assign(static_cast<size_t>(nv_), 0);
       mark_stamp_ = 0;
       cand_.resize(static_cast<size_t>(nv_));
       best_.resize(static_cast<size_t>(nv_));
@@ -559,8 +563,12 @@ class Simplifier {
       auto key = [this](int v) -> const HeapEntry& { return best_[static_cast<size_t>(v)]; };
       vheap_.remove(vt, key);
       cand_[static_cast<size_t>(vt)].clear();
+      // A neighbour of vs that was not one of vt's kept its faces, so its collapses cost
+      // the same; it is refreshed only if one of them was found illegal (the collapse
+      // may have made it legal, and the half-edge heap this replaces would retry it).
       refresh(vs);
-      for (int w : ns_) refresh(w);
+      for (int w : ns_)
+        if (dropped_[static_cast<size_t>(w)] || std::binary_search(nt_.begin(), nt_.end(), w)) refresh(w);
     } else {
       for (int w : ns_) push_edge(vs, w);
     }
@@ -583,6 +591,7 @@ class Simplifier {
   std::vector<int> nt_, ns_, ring_;
   std::vector<PlaneTerm> planes_;  // prepare_memoryless
   std::vector<std::uint32_t> mark_;  // refresh: stamp of the vertices already listed
+  std::vector<char> dropped_;        // memoryless: a candidate was found illegal since the last refresh
   std::uint32_t mark_stamp_ = 0;
   std::vector<std::vector<int>> path_nbr_;  // per vertex: its neighbours along path edges
   std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;  // accumulated quadrics

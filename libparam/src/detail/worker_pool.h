@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -47,6 +48,7 @@ class WorkerPool {
       for (int i = 0; i < n; ++i) body(i, 0);
       return;
     }
+    bool wake = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       body_ = &body;
@@ -55,17 +57,25 @@ class WorkerPool {
       next_.store(0);
       open_ = true;
       joined_ = 0;
-      ++generation_;
+      generation_.fetch_add(1, std::memory_order_release);
+      wake = sleeping_ > 0;
     }
-    start_cv_.notify_all();
+    if (wake) start_cv_.notify_all();
     run_chunks(0);
     // Wait only for the workers that joined while the loop was open: they are running
     // chunks now. One still waking up (tens of microseconds on a virtual machine, longer
     // than many of the optimizer's loops) finds the loop closed and goes back to sleep, so
     // its wake-up is never on the caller's path.
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      open_ = false;
+    }
+    // The joined workers are on their last chunks: watch for them briefly before sleeping.
+    const auto watch_end = std::chrono::steady_clock::now() + kWatch;
+    while (joined_.load(std::memory_order_acquire) > 0 && std::chrono::steady_clock::now() < watch_end)
+      std::this_thread::yield();
     std::unique_lock<std::mutex> lock(mutex_);
-    open_ = false;
-    done_cv_.wait(lock, [&] { return joined_ == 0; });
+    done_cv_.wait(lock, [&] { return joined_.load() == 0; });
     body_ = nullptr;
   }
 
@@ -83,11 +93,20 @@ class WorkerPool {
   void worker(int thread) {
     unsigned long seen = 0;
     for (;;) {
+      // The optimizer's loops come in bursts (a round's colour classes, a few microseconds of
+      // serial work apart): a worker that has just finished one watches for the next for a
+      // short while before it sleeps, so it joins at once instead of after a wake-up. The
+      // watch is bounded (kWatch), so an idle pool costs no CPU.
+      const auto watch_end = std::chrono::steady_clock::now() + kWatch;
+      while (generation_.load(std::memory_order_acquire) == seen && std::chrono::steady_clock::now() < watch_end)
+        std::this_thread::yield();
       {
         std::unique_lock<std::mutex> lock(mutex_);
-        start_cv_.wait(lock, [&] { return stop_ || generation_ != seen; });
+        ++sleeping_;
+        start_cv_.wait(lock, [&] { return stop_ || generation_.load() != seen; });
+        --sleeping_;
         if (stop_) return;
-        seen = generation_;
+        seen = generation_.load();
         if (!open_) continue;  // the caller has finished this loop without us
         ++joined_;
       }
@@ -104,9 +123,12 @@ class WorkerPool {
   std::mutex mutex_;
   std::condition_variable start_cv_, done_cv_;
   const std::function<void(int, int)>* body_ = nullptr;
-  int n_ = 0, chunk_ = 1, joined_ = 0;  // joined_: workers running the open loop
+  int n_ = 0, chunk_ = 1;
+  std::atomic<int> joined_{0};  // workers running the current loop (changed under mutex_)
   std::atomic<int> next_{0};
-  unsigned long generation_ = 0;
+  std::atomic<unsigned long> generation_{0};  // written under mutex_, watched without it
+  int sleeping_ = 0;                           // workers waiting on start_cv_
+  static constexpr std::chrono::microseconds kWatch{50};
   bool stop_ = false, open_ = false;
 };
 

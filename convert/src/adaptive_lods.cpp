@@ -11,6 +11,8 @@
 #include <limits>
 #include <string>
 
+#include <Eigen/Cholesky>
+
 #include "lod_constraints.h"
 #include "spherekit/progressive_mesh.h"
 
@@ -63,6 +65,71 @@ std::array<int, 3> face_texels(const std::array<int, 3>& v, const std::vector<st
         }
       }
   return best;
+}
+
+// Garland & Heckbert 1997's plane quadric of one 3D model: Q(x) = x'Ax + 2b'x + c, the
+// area-weighted squared distance of x to the planes summed into it.
+struct PlaneQuadric {
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  void add_face(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2, double weight) {
+    Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
+    const double twice_area = n.norm();
+    if (!(twice_area > 0)) return;
+    n /= twice_area;
+    const double w = weight * 0.5 * twice_area;
+    const double d = -n.dot(p0);
+    A += w * n * n.transpose();
+    b += w * d * n;
+  }
+  void add(const PlaneQuadric& q) {
+    A += q.A;
+    b += q.b;
+  }
+};
+
+// Each level vertex of each member at the minimum of its cluster's plane quadric (the fine
+// vertices that collapsed into it, each with a third of its faces' planes): a coarse surface
+// through samples of the fine one lies inside it wherever it is convex and outside where
+// concave; the quadric's minimum moves the vertex to straddle the fine surface, so both
+// directions of the surface distance shrink (Garland & Heckbert 1997 §5; the peers'
+// simplifiers keep input vertices). Regularized towards the texel sample (a flat cluster's
+// quadric has no unique minimum), and a vertex whose minimum lies farther from its sample
+// than the cluster's own extent keeps the sample (a degenerate or folded cluster).
+void fit_level_positions(const RowMatXd& P, const RowMat3i& F, const std::vector<std::uint8_t>& hole_faces,
+                         const CollapseReplay& replay, int nm, RowMatXd* fitted) {
+  const int nv = static_cast<int>(P.rows());
+  *fitted = P;
+  for (int m = 0; m < nm; ++m) {
+    std::vector<PlaneQuadric> q(static_cast<std::size_t>(nv));
+    std::vector<double> extent(static_cast<std::size_t>(nv), 0.0);
+    for (Eigen::Index f = 0; f < F.rows(); ++f) {
+      if (!hole_faces.empty() && hole_faces[static_cast<std::size_t>(f)]) continue;
+      const Eigen::Vector3d p0 = P.row(F(f, 0)).segment<3>(3 * m).transpose();
+      const Eigen::Vector3d p1 = P.row(F(f, 1)).segment<3>(3 * m).transpose();
+      const Eigen::Vector3d p2 = P.row(F(f, 2)).segment<3>(3 * m).transpose();
+      PlaneQuadric face;
+      face.add_face(p0, p1, p2, 1.0 / 3.0);
+      for (int k = 0; k < 3; ++k) q[static_cast<std::size_t>(replay.find(F(f, k)))].add(face);
+    }
+    for (int v = 0; v < nv; ++v) {
+      const int c = replay.find(v);
+      const double dist = (P.row(v).segment<3>(3 * m) - P.row(c).segment<3>(3 * m)).norm();
+      extent[static_cast<std::size_t>(c)] = std::max(extent[static_cast<std::size_t>(c)], dist);
+    }
+    for (int c = 0; c < nv; ++c) {
+      if (replay.find(c) != c) continue;
+      const PlaneQuadric& qc = q[static_cast<std::size_t>(c)];
+      const double tr = qc.A.trace();
+      if (!(tr > 0) || !(extent[static_cast<std::size_t>(c)] > 0)) continue;
+      const Eigen::Vector3d x0 = P.row(c).segment<3>(3 * m).transpose();
+      const double lambda = 1e-3 * tr;
+      const Eigen::Matrix3d A = qc.A + lambda * Eigen::Matrix3d::Identity();
+      const Eigen::Vector3d x = A.ldlt().solve(lambda * x0 - qc.b);
+      if (!x.allFinite() || (x - x0).norm() > extent[static_cast<std::size_t>(c)]) continue;
+      fitted->row(c).segment<3>(3 * m) = x.transpose();
+    }
+  }
 }
 
 Status check_members(const std::vector<GeometryImage>& members, const AdaptiveLodOptions& options) {
@@ -146,6 +213,8 @@ Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector
   for (int k = 0; k < options.levels; ++k) {
     const std::size_t want = static_cast<std::size_t>(std::max(0, nv - targets[static_cast<std::size_t>(k)]));
     replay.advance_to(want);
+    RowMatXd level_positions;
+    if (options.fit_positions) fit_level_positions(P, F, hole_faces, replay, nm, &level_positions);
     // Faces in input order, corners as texels; points = texels used, ascending.
     std::vector<std::array<int, 3>> faces;
     std::vector<char> used(welded.size(), 0);
@@ -188,7 +257,12 @@ Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector
       mesh.N.resize(np, 3);
       for (Eigen::Index p = 0; p < np; ++p) {
         const std::size_t t = static_cast<std::size_t>(texel_of[static_cast<std::size_t>(p)]);
-        for (int c = 0; c < 3; ++c) mesh.V(p, c) = g.positions[3 * t + c];
+        if (options.fit_positions) {
+          const int v = welded[t];
+          for (int c = 0; c < 3; ++c) mesh.V(p, c) = level_positions(v, 3 * m + c);
+        } else {
+          for (int c = 0; c < 3; ++c) mesh.V(p, c) = g.positions[3 * t + c];
+        }
         Eigen::Vector3d nrm(g.normals[3 * t], g.normals[3 * t + 1], g.normals[3 * t + 2]);
         const double len = nrm.norm();
         // As gltf_mesh_from_geometry_image: glTF NORMALs must be unit vectors.

@@ -5,9 +5,10 @@
 // The remesh of the finest image (geometry_image_mesh: a closed genus-0 manifold, one vertex
 // per welded texel) is simplified by libparam's progressive mesh (half-edge collapses at the
 // original positions, ordered by the n-D quadric, Garland & Heckbert 1998). Vertices keep
-// their positions, so every vertex of every level is a texel of the finest image and keeps
-// its texture coordinate exactly (gltf_mesh.h convention): one texture or normal map made from
-// the image serves every level.
+// their texels, so every vertex of every level keeps its texel's texture coordinate exactly
+// (gltf_mesh.h convention): one texture or normal map made from the image serves every level.
+// Positions: by default each level vertex moves to the minimum of its cluster's quadric
+// (fit_positions), so that the coarse surface straddles the fine one.
 //
 // Seams. Texture coordinates jump where the octahedron folds (the border of the square
 // domain, welded pairwise, and its four corners, one vertex). Those border edges are given to
@@ -54,6 +55,10 @@ struct AdaptiveLodOptions {
   /// surface too and was dropped with it: the bunny's coarsest level lost whole patches
   /// around its base (22.7 dB). Changes the connectivity per member: single meshes only.
   bool drop_hole_faces = false;
+  /// Place each level's vertices at the minimum of their cluster's plane quadric, per member
+  /// (Garland & Heckbert 1997), instead of at their texel's sample; texture coordinates stay
+  /// the texel's. false: every vertex is its texel's sample exactly.
+  bool fit_positions = true;
 };
 
 /// The adaptive levels of one or more members (consistent geometry images of one size):

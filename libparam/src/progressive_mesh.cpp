@@ -324,7 +324,7 @@ class Simplifier {
   void refresh(int vt) {
     auto& list = cand_[static_cast<size_t>(vt)];
     list.clear();
-    dropped_[static_cast<size_t>(vt)] = 0;
+    dropped_to_[static_cast<size_t>(vt)].clear();
     const bool keep = !opt_.keep_vertices.empty() && opt_.keep_vertices[static_cast<size_t>(vt)];
     if (!keep) {
       // Neighbours in face-walk order (the candidates' order does not matter: the cheapest
@@ -390,7 +390,7 @@ class Simplifier {
   }
   void drop_candidate(int vt, int vs) {
     auto& list = cand_[static_cast<size_t>(vt)];
-    dropped_[static_cast<size_t>(vt)] = 1;
+    dropped_to_[static_cast<size_t>(vt)].push_back(vs);
     for (size_t i = 0; i < list.size(); ++i)
       if (list[i].vs == vs) {
         list.erase(list.begin() + static_cast<std::ptrdiff_t>(i));
@@ -428,7 +428,7 @@ class Simplifier {
   void rebuild_heap() {
     if (opt_.memoryless) {
       mark_.assign(static_cast<size_t>(nv_), 0);
-      dropped_.assign(static_cast<size_t>(nv_), 0);
+      dropped_to_.assign(static_cast<size_t>(nv_), {});
       mark_stamp_ = 0;
       cand_.resize(static_cast<size_t>(nv_));
       best_.resize(static_cast<size_t>(nv_));
@@ -563,12 +563,35 @@ class Simplifier {
       auto key = [this](int v) -> const HeapEntry& { return best_[static_cast<size_t>(v)]; };
       vheap_.remove(vt, key);
       cand_[static_cast<size_t>(vt)].clear();
-      // A neighbour of vs that was not one of vt's kept its faces, so its collapses cost
-      // the same; it is refreshed only if one of them was found illegal (the collapse
-      // may have made it legal, and the half-edge heap this replaces would retry it).
+      // The half-edge heap this replaces re-pushed every half-edge touching vs or its new
+      // neighbours, so each of them is untried again (a collapse found illegal may have become
+      // legal: the link condition and the valence cap read both ends). vs and vt's former
+      // neighbours have new faces: all their collapses are recomputed. A neighbour of vs that
+      // was not one of vt's kept its faces, so its collapses cost the same: it is refreshed
+      // only if one of them was dropped. A vertex beyond gets back the collapse towards the
+      // ring it had dropped, if any.
       refresh(vs);
       for (int w : ns_)
-        if (dropped_[static_cast<size_t>(w)] || std::binary_search(nt_.begin(), nt_.end(), w)) refresh(w);
+        if (!dropped_to_[static_cast<size_t>(w)].empty() || std::binary_search(nt_.begin(), nt_.end(), w)) refresh(w);
+      ++mark_stamp_;
+      mark_[static_cast<size_t>(vs)] = mark_stamp_;
+      for (int w : ns_) mark_[static_cast<size_t>(w)] = mark_stamp_;
+      const std::uint32_t ring_stamp = mark_stamp_;
+      auto restore_towards = [&](int x) {
+        for (int f : vf_[x])
+          for (int w : faces_[f]) {
+            auto& dropped = dropped_to_[static_cast<size_t>(w)];
+            if (mark_[static_cast<size_t>(w)] == ring_stamp || dropped.empty()) continue;
+            const auto it = std::find(dropped.begin(), dropped.end(), x);
+            if (it == dropped.end()) continue;
+            dropped.erase(it);
+            prepare_memoryless(w);
+            cand_[static_cast<size_t>(w)].push_back({memoryless_cost(w, x), x});
+            choose_best(w);
+          }
+      };
+      restore_towards(vs);
+      for (int x : ns_) restore_towards(x);
     } else {
       for (int w : ns_) push_edge(vs, w);
     }
@@ -591,7 +614,7 @@ class Simplifier {
   std::vector<int> nt_, ns_, ring_;
   std::vector<PlaneTerm> planes_;  // prepare_memoryless
   std::vector<std::uint32_t> mark_;  // refresh: stamp of the vertices already listed
-  std::vector<char> dropped_;        // memoryless: a candidate was found illegal since the last refresh
+  std::vector<std::vector<int>> dropped_to_;  // memoryless: targets found illegal since the last refresh
   std::uint32_t mark_stamp_ = 0;
   std::vector<std::vector<int>> path_nbr_;  // per vertex: its neighbours along path edges
   std::priority_queue<HeapEntry, std::vector<HeapEntry>, HeapGreater> heap_;  // accumulated quadrics

@@ -133,7 +133,7 @@ class Refiner {
     rings_.resize(static_cast<size_t>(pool_.threads()));
     for (int i = total - 1; i >= 0;) {
       // The splits are replayed in order; a run of consecutive splits whose regions are
-      // disjoint (split_region) commute, so they are applied first and their new vertices
+      // disjoint (claim_split_region) commute, so they are applied first and their new vertices
       // placed in parallel: the same positions as one split after another, for any number
       // of threads (the run's extent depends on the mesh only).
       batch_.clear();

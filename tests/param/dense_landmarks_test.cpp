@@ -285,8 +285,8 @@ TEST_CASE("shared faust5k: 64 and 128 dense landmarks, 2 members, give a complet
   auto r = parameterize_consistent({a, b}, sets, o);
   INFO((r.ok() ? std::string() : r.status().message()));
   // Issue 19 (open): with 128 landmarks (two of them 2 edges apart on 013) the dense route is
-  // chaotic: it completed on one machine (47 s) and fails on another with the same code
-  // (likely glibc's libm, which picks FMA or non-FMA variants by CPU), after 13 network variants: every
+  // chaotic: it completed on one machine (47 s) and fails on another with the same code (likely
+  // glibc's libm, which picks FMA or non-FMA variants by CPU) after 13 network variants: every
   // subset either stalls the warp (features passing each other) or, grown by the stalled
   // features, leaves a fold after the Steiner removal. Reported as a skip with the reason,
   // never as a pass; 64 landmarks must complete.

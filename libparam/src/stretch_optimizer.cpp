@@ -23,6 +23,7 @@
 #include <cmath>
 #include <limits>
 
+#include "detail/gram_derivatives.h"
 #include "detail/sphere_state.h"
 #include "detail/worker_pool.h"
 #include "spherekit/predicates.h"
@@ -397,7 +398,7 @@ inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, 
 
 
 double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x, double reg_weight,
-                   double split_distance) {
+                   double split_distance, double* face_energy) {
   double energy = 0;
   for (size_t i = 0; i < ring.faces.size(); ++i) {
     const auto& rf = ring.faces[i];
@@ -412,20 +413,104 @@ double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::
     const bool large = det * det < split_distance * split_distance * cross2;
     if (rf.real && st.hole_area_penalty > 0) energy += st.hole_area_penalty * 0.5 * std::sqrt(cross2);
     for (int m = 0; m < st.models; ++m) {
-      const double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
+      const size_t k = i * static_cast<size_t>(st.models) + static_cast<size_t>(m);
+      const double* s = &ring.surf[k * kSurfStride];
       const double scale = st.model_scale[static_cast<size_t>(m)];
+      double e;
       if (!large) {
-        energy += gram_energy(e1, e2, s, scale, reg_weight, st.edge_frame_cruft);
+        e = gram_energy(e1, e2, s, scale, reg_weight, st.edge_frame_cruft);
       } else {
         const Eigen::Vector3d q[3] = {x, rf.qa, rf.qb};
         const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
                                       Eigen::Vector3d(s[6], s[7], s[8])};
-        energy += split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
+        e = split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
       }
+      if (face_energy) face_energy[k] = e;
+      energy += e;
     }
     if (!std::isfinite(energy)) return kInf;
   }
   return energy;
+}
+
+namespace {
+
+// One ring face's energy for one model with v at y (ring_energy's per-face rule, without the
+// hole-area term): the accordion split where the chord plane is closer than split_distance.
+double face_model_energy(const SphereState& st, const RingScratch::Face& rf, const double* s, double scale,
+                         const Eigen::Vector3d& y, double reg_weight, double split_distance) {
+  const Eigen::Vector3d e1 = rf.qa - y, e2 = rf.qb - y;
+  const double det = y.dot(rf.n);
+  if (!(det > 0)) return kInf;
+  const double cross2 = e1.cross(e2).squaredNorm();
+  if (!(det * det < split_distance * split_distance * cross2))
+    return gram_energy(e1, e2, s, scale, reg_weight, st.edge_frame_cruft);
+  const Eigen::Vector3d q[3] = {y, rf.qa, rf.qb};
+  const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
+                                Eigen::Vector3d(s[6], s[7], s[8])};
+  return split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
+}
+
+}  // namespace
+
+bool ring_tangent_derivatives(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x,
+                              const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, double h, double reg_weight,
+                              double split_distance, const double* energy_at_x, Eigen::Vector2d* g,
+                              Eigen::Matrix2d* H) {
+  g->setZero();
+  H->setZero();
+  // Chart points of the difference stencil, formed at the first face that needs them.
+  Eigen::Vector3d y[5];
+  bool have_stencil = false;
+  for (size_t i = 0; i < ring.faces.size(); ++i) {
+    const auto& rf = ring.faces[i];
+    const Eigen::Vector3d e1 = rf.qa - x, e2 = rf.qb - x;
+    const double det = x.dot(rf.n);
+    if (!(det > 0)) return false;
+    const double cross2 = e1.cross(e2).squaredNorm();
+    const bool large = det * det < split_distance * split_distance * cross2;
+    const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
+    GramJet face;
+    if (rf.real && st.hole_area_penalty > 0) {
+      // hole_area_penalty * area = hole_area_penalty / 2 * Q^(1/2)
+      const GramJet Q = gram_jet::area_jet(E11, E22, E12);
+      if (!(Q.v > 0)) return false;
+      const double r = 1 / std::sqrt(Q.v);
+      gram_jet::add_composed(face, Q, Q.v * r, 0.5 * r, -0.25 * r / Q.v, 0.5 * st.hole_area_penalty);
+    }
+    for (int m = 0; m < st.models; ++m) {
+      const size_t k = i * static_cast<size_t>(st.models) + static_cast<size_t>(m);
+      const double* s = &ring.surf[k * kSurfStride];
+      const double scale = st.model_scale[static_cast<size_t>(m)];
+      if (!large && add_gram_energy_jet(E11, E22, E12, s, scale, reg_weight, &face)) continue;
+      // Faces of the accordion split (and points where the closed form fails): central
+      // differences of this face alone, the stencil newton_move used for the whole ring.
+      if (!have_stencil) {
+        y[1] = (x + h * t1).normalized();
+        y[2] = (x - h * t1).normalized();
+        y[3] = (x + h * t2).normalized();
+        y[4] = (x - h * t2).normalized();
+        y[0] = (x + h * t1 + h * t2).normalized();
+        have_stencil = true;
+      }
+      const double f0 = energy_at_x ? energy_at_x[k] : face_model_energy(st, rf, s, scale, x, reg_weight, split_distance);
+      double f[5];
+      for (int c = 0; c < 5; ++c) {
+        f[c] = face_model_energy(st, rf, s, scale, y[c], reg_weight, split_distance);
+        if (!std::isfinite(f[c])) return false;
+      }
+      if (!std::isfinite(f0)) return false;
+      (*g)(0) += (f[1] - f[2]) / (2 * h);
+      (*g)(1) += (f[3] - f[4]) / (2 * h);
+      (*H)(0, 0) += (f[1] - 2 * f0 + f[2]) / (h * h);
+      (*H)(1, 1) += (f[3] - 2 * f0 + f[4]) / (h * h);
+      const double h12 = (f[0] - f[1] - f[3] + f0) / (h * h);
+      (*H)(0, 1) += h12;
+      (*H)(1, 0) += h12;
+    }
+    gram_jet_to_tangent(face, e1, e2, x, t1, t2, g, H);
+  }
+  return g->allFinite() && H->allFinite();
 }
 
 bool ring_valid_exact(const RingScratch& ring, const Eigen::Vector3d& x) {
@@ -436,14 +521,16 @@ bool ring_valid_exact(const RingScratch& ring, const Eigen::Vector3d& x) {
 
 namespace {
 
-// One safeguarded Newton step in the tangent plane at x. The gradient and Hessian of the ring
-// energy come from central differences on the gnomonic chart y = normalize(x + u e1 + w e2)
-// with a step of 1e-4 of the shortest chord to a neighbour (well inside the kernel and far
-// above rounding). A positive-definite Hessian gives the step -H^-1 g, clipped to the
-// kernel and shortened until the energy decreases and the exact test passes. Six energy
-// evaluations replace the ~20 of two Brent searches, and the step is far better aimed.
+// One safeguarded Newton step in the tangent plane at x, on the gnomonic chart
+// y = normalize(x + u e1 + w e2). The gradient and Hessian of the ring energy are analytic for
+// the faces measured on their chord triangles (ring_tangent_derivatives) and central
+// differences (step 1e-4 of the shortest chord to a neighbour: well inside the kernel and far
+// above rounding) for the faces of the accordion split, and for the whole ring in the
+// collection stages' energy. A positive-definite Hessian gives the step -H^-1 g, clipped to
+// the kernel and shortened until the energy decreases and the exact test passes.
+// ring.energy_here holds the faces' energies at x (kept current on acceptance).
 // Returns false (x unchanged) when the model is not convex or no decrease is found.
-bool newton_move(const SphereState& st, const RingScratch& ring, const OptimizerSettings& s, Eigen::Vector3d& x,
+bool newton_move(const SphereState& st, RingScratch& ring, const OptimizerSettings& s, Eigen::Vector3d& x,
                  double& ecur) {
   double hmin = kInf;
   for (const auto& rf : ring.faces) hmin = std::min(hmin, (rf.qa - x).norm());
@@ -451,15 +538,25 @@ bool newton_move(const SphereState& st, const RingScratch& ring, const Optimizer
   Eigen::Vector3d e1, e2;
   tangent_basis(x, e1, e2);
   const double h = 1e-4 * hmin;
-  auto F = [&](double u, double w) {
-    return ring_energy(st, ring, (x + u * e1 + w * e2).normalized(), s.regularizer_weight, s.split_distance);
-  };
-  const double fp1 = F(h, 0), fm1 = F(-h, 0), fp2 = F(0, h), fm2 = F(0, -h), fpp = F(h, h);
-  if (!(std::isfinite(fp1) && std::isfinite(fm1) && std::isfinite(fp2) && std::isfinite(fm2) && std::isfinite(fpp)))
-    return false;
-  const double g1 = (fp1 - fm1) / (2 * h), g2 = (fp2 - fm2) / (2 * h);
-  const double H11 = (fp1 - 2 * ecur + fm1) / (h * h), H22 = (fp2 - 2 * ecur + fm2) / (h * h);
-  const double H12 = (fpp - fp1 - fp2 + ecur) / (h * h);
+  double g1, g2, H11, H22, H12;
+  if (st.edge_frame_cruft) {
+    Eigen::Vector2d g;
+    Eigen::Matrix2d H;
+    if (!ring_tangent_derivatives(st, ring, x, e1, e2, h, s.regularizer_weight, s.split_distance,
+                                  ring.energy_here.data(), &g, &H))
+      return false;
+    g1 = g(0), g2 = g(1), H11 = H(0, 0), H22 = H(1, 1), H12 = H(0, 1);
+  } else {
+    auto F = [&](double u, double w) {
+      return ring_energy(st, ring, (x + u * e1 + w * e2).normalized(), s.regularizer_weight, s.split_distance);
+    };
+    const double fp1 = F(h, 0), fm1 = F(-h, 0), fp2 = F(0, h), fm2 = F(0, -h), fpp = F(h, h);
+    if (!(std::isfinite(fp1) && std::isfinite(fm1) && std::isfinite(fp2) && std::isfinite(fm2) && std::isfinite(fpp)))
+      return false;
+    g1 = (fp1 - fm1) / (2 * h), g2 = (fp2 - fm2) / (2 * h);
+    H11 = (fp1 - 2 * ecur + fm1) / (h * h), H22 = (fp2 - 2 * ecur + fm2) / (h * h);
+    H12 = (fpp - fp1 - fp2 + ecur) / (h * h);
+  }
   const double det = H11 * H22 - H12 * H12;
   if (!(H11 > 0 && det > 0)) return false;
   const double du = -(H22 * g1 - H12 * g2) / det, dw = -(H11 * g2 - H12 * g1) / det;
@@ -471,10 +568,11 @@ bool newton_move(const SphereState& st, const RingScratch& ring, const Optimizer
   double t = std::min(std::atan(len), hi);
   for (int tries = 0; tries < 4; ++tries, t *= 0.3) {
     Eigen::Vector3d y = (x * std::cos(t) + d * std::sin(t)).normalized();
-    double ey = ring_energy(st, ring, y, s.regularizer_weight, s.split_distance);
+    double ey = ring_energy(st, ring, y, s.regularizer_weight, s.split_distance, ring.energy_trial.data());
     if (ey < ecur && ring_valid_exact(ring, y)) {
       x = y;
       ecur = ey;
+      ring.energy_here.swap(ring.energy_trial);
       return true;
     }
   }
@@ -487,7 +585,10 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
                      RingScratch& ring, Eigen::Vector3d* out, int searches) {
   if (!load_ring(st, v, ring)) return false;
   Eigen::Vector3d x = st.S.row(v).transpose();
-  double e0 = ring_energy(st, ring, x, s.regularizer_weight, s.split_distance);
+  const size_t per_model = ring.faces.size() * static_cast<size_t>(st.models);
+  ring.energy_here.resize(per_model);
+  ring.energy_trial.resize(per_model);
+  double e0 = ring_energy(st, ring, x, s.regularizer_weight, s.split_distance, ring.energy_here.data());
   if (!std::isfinite(e0)) e0 = std::numeric_limits<double>::max();
   double ecur = e0;
   bool improved = false;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "detail/sphere_state.h"
+#include "spherekit/predicates.h"
 #include "test_meshes.h"
 
 using namespace spherekit;
@@ -126,4 +127,101 @@ TEST_CASE("the anti-cruft term: exact on conformal faces, never above the smalle
     }
     CHECK(strictly_less);
   }
+}
+
+namespace {
+
+// Differences of ring_energy on the chart y = normalize(x + u t1 + w t2). order 4: steps h and
+// 2h, far more accurate than the comparison's tolerance where the energy is smooth; order 2:
+// the five-point stencil newton_move took over the whole ring before the derivatives were
+// analytic (the split energy has kinks where a face's longest edge changes, so it is
+// compared at that stencil's own small step).
+void ring_differences(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x,
+                      const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, double h, double split, int order,
+                      Eigen::Vector2d* g, Eigen::Matrix2d* H) {
+  auto F = [&](double u, double w) { return ring_energy(st, ring, (x + u * t1 + w * t2).normalized(), 1e-4, split); };
+  const double f0 = F(0, 0);
+  if (order == 2) {
+    const double fp1 = F(h, 0), fm1 = F(-h, 0), fp2 = F(0, h), fm2 = F(0, -h), fpp = F(h, h);
+    (*g) << (fp1 - fm1) / (2 * h), (fp2 - fm2) / (2 * h);
+    const double h12 = (fpp - fp1 - fp2 + f0) / (h * h);
+    (*H) << (fp1 - 2 * f0 + fm1) / (h * h), h12, h12, (fp2 - 2 * f0 + fm2) / (h * h);
+    return;
+  }
+  auto d1 = [&](double du, double dw) {
+    return (-F(2 * h * du, 2 * h * dw) + 8 * F(h * du, h * dw) - 8 * F(-h * du, -h * dw) + F(-2 * h * du, -2 * h * dw)) /
+           (12 * h);
+  };
+  auto d2 = [&](double du, double dw) {
+    return (-F(2 * h * du, 2 * h * dw) + 16 * F(h * du, h * dw) - 30 * f0 + 16 * F(-h * du, -h * dw) -
+            F(-2 * h * du, -2 * h * dw)) /
+           (12 * h * h);
+  };
+  (*g) << d1(1, 0), d1(0, 1);
+  const double huu = d2(1, 0), hww = d2(0, 1);
+  // Second difference along the diagonal: (t1 + t2) H (t1 + t2) = huu + hww + 2 huw.
+  const double hdiag = d2(1, 1);
+  const double huw = 0.5 * (hdiag - huu - hww);
+  (*H) << huu, huw, huw, hww;
+}
+
+}  // namespace
+
+TEST_CASE("the Newton steps' analytic ring derivatives match differences of the ring energy",
+          "[param][sphere][energy]") {
+  // An irregular sphere map of an anisotropic surface: jittered icosphere vertices (still
+  // a valid embedding), surface = the sphere stretched 3 x 1 x 0.4, some faces as hole
+  // faces with the shape term and a hole-area penalty on the others: every term of the
+  // small-face energy, and (split 0.99) faces of the accordion split by differences.
+  const TriMesh m = test::icosphere(2);
+  RowMat3d S = m.V;
+  for (int v = 0; v < static_cast<int>(S.rows()); ++v) {
+    const double a = 0.37 * v, b = 1.3 * v;
+    S.row(v) += 0.02 * Eigen::RowVector3d(std::sin(a), std::cos(b), std::sin(a + b));
+  }
+  S.rowwise().normalize();
+  RowMatXd P = S;
+  P.col(0) *= 3.0;
+  P.col(2) *= 0.4;
+  SphereState st = make_state(m, S, P);
+  for (const auto& c : st.F) REQUIRE(orient3d_origin(S.row(c[0]).transpose(), S.row(c[1]).transpose(), S.row(c[2]).transpose()) > 0);
+  st.face_shape_weight.assign(st.F.size(), 0.0);
+  for (size_t f = 0; f < st.F.size(); f += 7) {
+    st.face_shape_weight[f] = 0.3;
+    st.face_weight[f] = 1e-3;
+  }
+  st.update_areas();
+  st.hole_area_penalty = 0.05;
+  int compared = 0, with_split = 0;
+  for (double split : {0.0, 0.99}) {
+    for (int v = 0; v < static_cast<int>(S.rows()); v += 3) {
+      RingScratch ring;
+      REQUIRE(load_ring(st, v, ring));
+      const Eigen::Vector3d x = st.S.row(v).transpose();
+      if (!std::isfinite(ring_energy(st, ring, x, 1e-4, split))) continue;
+      Eigen::Vector3d t1, t2;
+      tangent_basis(x, t1, t2);
+      double hmin = 1e9;
+      for (const auto& rf : ring.faces) hmin = std::min(hmin, (rf.qa - x).norm());
+      Eigen::Vector2d ga, gd;
+      Eigen::Matrix2d Ha, Hd;
+      REQUIRE(ring_tangent_derivatives(st, ring, x, t1, t2, 1e-4 * hmin, 1e-4, split, nullptr, &ga, &Ha));
+      if (split == 0.0)
+        ring_differences(st, ring, x, t1, t2, 1e-3 * hmin, split, 4, &gd, &Hd);
+      else
+        ring_differences(st, ring, x, t1, t2, 1e-4 * hmin, split, 2, &gd, &Hd);
+      const double gs = std::max(gd.norm(), 1e-12), hs = Hd.norm();
+      // Analytic faces agree to rounding; with the accordion faces, both sides carry the
+      // stencil's own difference error.
+      const double tol = split == 0.0 ? 1e-6 : 1e-4;
+      INFO("v " << v << " split " << split << " ga " << ga.transpose() << " gd " << gd.transpose() << " Ha " << Ha << " Hd " << Hd);
+      CHECK((ga - gd).norm() <= tol * gs + 1e-9 * hs * hmin);
+      CHECK((Ha - Hd).norm() <= tol * hs);
+      CHECK(Ha(0, 1) == Ha(1, 0));
+      ++compared;
+      if (split > 0) ++with_split;
+    }
+  }
+  CHECK(compared > 100);
+  CHECK(with_split > 50);
 }

@@ -96,6 +96,9 @@ struct RingScratch {
   };
   std::vector<Face> faces;
   std::vector<double> surf;  ///< per face and model: d1 (3), d2 (3), area weight (1)
+  /// Per face and model, the energy at the vertex's current point and at a trial point
+  /// (ring_energy's face_energy; the Newton steps reuse the current one).
+  std::vector<double> energy_here, energy_trial;
 };
 
 /// Loads v's ring into scratch. Returns false if v has no faces.
@@ -104,8 +107,21 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring);
 /// Stretch energy of v's ring with v at sphere point x (+inf if a chord triangle degenerates).
 /// Faces whose chord plane is closer to the centre than `split_distance` are evaluated with
 /// the accordion split; 0 evaluates every face on its chord triangle (the measured energy).
+/// `face_energy` (optional, faces x models) receives each face's energy per model, without
+/// the hole-area term; complete only when the result is finite.
 double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x, double reg_weight,
-                   double split_distance);
+                   double split_distance, double* face_energy = nullptr);
+
+/// Gradient g and Hessian H of ring_energy at the unit point x on the chart
+/// y(u, w) = normalize(x + u t1 + w t2) (t1, t2 an orthonormal tangent basis): analytic for
+/// the faces evaluated on their chord triangle with edge-frame anti-cruft terms
+/// (gram_derivatives.h), central differences of step h for the faces of the accordion split
+/// (`energy_at_x`: ring_energy's face_energy at x, or null to recompute those).
+/// Returns false where the energy is not finite or a derivative cannot be formed.
+bool ring_tangent_derivatives(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x,
+                              const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, double h, double reg_weight,
+                              double split_distance, const double* energy_at_x, Eigen::Vector2d* g,
+                              Eigen::Matrix2d* H);
 
 /// True if every ring face is positively oriented with v at x, by exact predicate.
 bool ring_valid_exact(const RingScratch& ring, const Eigen::Vector3d& x);

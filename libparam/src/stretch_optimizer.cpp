@@ -229,19 +229,36 @@ OptimizerSettings settings_for_effort(int effort) {
   return s;
 }
 
-bool load_ring(const SphereState& st, int v, RingScratch& ring) {
-  const auto& faces = st.vf[static_cast<size_t>(v)];
-  ring.faces.resize(faces.size());
-  ring.surf.resize(faces.size() * static_cast<size_t>(st.models) * kSurfStride);
+bool load_ring(const SphereState& st, int v, RingScratch& ring, const RingIndex* index) {
+  const int* indexed_faces = nullptr;
+  const int* indexed_corners = nullptr;
+  size_t count;
+  if (index) {
+    const int b = index->start[static_cast<size_t>(v)];
+    count = static_cast<size_t>(index->start[static_cast<size_t>(v) + 1] - b);
+    indexed_faces = index->faces.data() + b;
+    indexed_corners = index->corners.data() + 2 * static_cast<size_t>(b);
+  } else {
+    count = st.vf[static_cast<size_t>(v)].size();
+  }
+  ring.faces.resize(count);
+  ring.surf.resize(count * static_cast<size_t>(st.models) * kSurfStride);
   const RowMatXd& P = *st.P;
-  for (size_t i = 0; i < faces.size(); ++i) {
-    int f = faces[i];
-    const auto& c = st.F[static_cast<size_t>(f)];
-    int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+  for (size_t i = 0; i < count; ++i) {
     auto& rf = ring.faces[i];
-    rf.f = f;
-    rf.a = c[(k + 1) % 3];
-    rf.b = c[(k + 2) % 3];
+    if (index) {
+      rf.f = indexed_faces[i];
+      rf.a = indexed_corners[2 * i];
+      rf.b = indexed_corners[2 * i + 1];
+    } else {
+      const int f = st.vf[static_cast<size_t>(v)][i];
+      const auto& c = st.F[static_cast<size_t>(f)];
+      const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+      rf.f = f;
+      rf.a = c[(k + 1) % 3];
+      rf.b = c[(k + 2) % 3];
+    }
+    const int f = rf.f;
     rf.qa = st.S.row(rf.a).transpose();
     rf.qb = st.S.row(rf.b).transpose();
     rf.n = rf.qa.cross(rf.qb);
@@ -270,7 +287,7 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring) {
                         st.model_area[static_cast<size_t>(m)];
     }
   }
-  return !faces.empty();
+  return count > 0;
 }
 
 namespace {
@@ -312,30 +329,35 @@ inline double singular_cruft_term(double T, double D, double reg_weight) {
   return g > 0 ? reg_weight / (g * g * g) : kInf;
 }
 
-// Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, formed explicitly.
+// Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, from the Gram entries of
+// its domain edges e1, e2 and surface edges d1, d2 (as gram_energy; the surface edges of
+// the split's halves move with the split point, so they are formed here):
+// |J|_F^2 = (E22 D11 + E11 D22 - 2 E12 D12) / Q, det J^T J = |d1 x d2|^2 / Q,
+// Q = E11 E22 - E12^2 = (2 A_dom)^2. One square root (the surface area) and no frame.
 inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                            const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
                            double scale, double floor, double reg_weight, double weight, double shape_weight,
                            bool edge_frames) {
-  Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
-  double l1sq = e1.squaredNorm();
-  if (!(l1sq > 0)) return kInf;
-  double l1 = std::sqrt(l1sq);
-  double e2u = e2.dot(e1) / l1;
-  double hsq = e2.squaredNorm() - e2u * e2u;
-  if (!(hsq > 1e-24 * l1sq)) return kInf;  // chord triangle (numerically) collapsed
-  double h = std::sqrt(hsq);
-  Eigen::Vector3d d1 = p1 - p0, d2 = p2 - p0;
-  Eigen::Vector3d Ss = d1 / l1;
-  Eigen::Vector3d St = (d2 - e2u * Ss) / h;
-  double a = Ss.squaredNorm() * scale, c = St.squaredNorm() * scale, b = Ss.dot(St) * scale;
-  double T = a + c, D = a * c - b * b;
-  const Eigen::Vector3d e3 = e2 - e1, d3 = d2 - d1;
-  double reg = edge_frames ? cruft_term(T, a, scale * d2.squaredNorm() / e2.squaredNorm(),
-                                        scale * d3.squaredNorm() / e3.squaredNorm(), reg_weight)
-                           : singular_cruft_term(T, D, reg_weight);
-  double area = 0.5 * d1.cross(d2).norm();
-  double e = weight * (area + floor) * (0.5 * (a + c) + reg);
+  const Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
+  const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
+  if (!(E11 > 0)) return kInf;
+  const double Q = E11 * E22 - E12 * E12;
+  if (!(Q > 1e-24 * E11 * E11)) return kInf;  // chord triangle (numerically) collapsed
+  const Eigen::Vector3d d1 = p1 - p0, d2 = p2 - p0;
+  const double D11 = d1.squaredNorm(), D22 = d2.squaredNorm(), D12 = d1.dot(d2);
+  const double iQ = 1 / Q;
+  const double T = gram_frobenius_numerator(E11, E22, E12, D11, D22, D12) * scale * iQ;
+  const double cross2 = d1.cross(d2).squaredNorm();
+  const double D = cross2 * (scale * scale) * iQ;
+  double reg;
+  if (edge_frames) {
+    const Eigen::Vector3d e3 = e2 - e1, d3 = d2 - d1;
+    reg = cruft_term(T, scale * D11 / E11, scale * D22 / E22, scale * d3.squaredNorm() / e3.squaredNorm(), reg_weight);
+  } else {
+    reg = singular_cruft_term(T, D, reg_weight);
+  }
+  const double area = 0.5 * std::sqrt(cross2);
+  double e = weight * (area + floor) * (0.5 * T + reg);
   if (shape_weight != 0) e += D > 0 ? 0.5 * shape_weight * (0.5 * T / std::sqrt(D)) : kInf;
   return e;
 }
@@ -581,9 +603,37 @@ bool newton_move(const SphereState& st, RingScratch& ring, const OptimizerSettin
 
 }  // namespace
 
+void build_ring_index(const SphereState& st, WorkerPool* pool, RingIndex* index) {
+  const int nv = static_cast<int>(st.S.rows());
+  index->start.assign(static_cast<size_t>(nv) + 1, 0);
+  for (int v = 0; v < nv; ++v)
+    index->start[static_cast<size_t>(v) + 1] =
+        index->start[static_cast<size_t>(v)] +
+        (st.vertex_alive[static_cast<size_t>(v)] ? static_cast<int>(st.vf[static_cast<size_t>(v)].size()) : 0);
+  index->faces.resize(static_cast<size_t>(index->start.back()));
+  index->corners.resize(2 * index->faces.size());
+  auto fill = [&](int v, int) {
+    if (!st.vertex_alive[static_cast<size_t>(v)]) return;
+    const size_t b = static_cast<size_t>(index->start[static_cast<size_t>(v)]);
+    int* faces = index->faces.data() + b;
+    int* corners = index->corners.data() + 2 * b;
+    for (int f : st.vf[static_cast<size_t>(v)]) {
+      const auto& c = st.F[static_cast<size_t>(f)];
+      const int k = c[0] == v ? 0 : c[1] == v ? 1 : 2;
+      *faces++ = f;
+      *corners++ = c[(k + 1) % 3];
+      *corners++ = c[(k + 2) % 3];
+    }
+  };
+  if (pool)
+    pool->parallel_for(nv, 256, 1024, fill);
+  else
+    for (int v = 0; v < nv; ++v) fill(v, 0);
+}
+
 bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const OptimizerSettings& s,
-                     RingScratch& ring, Eigen::Vector3d* out, int searches) {
-  if (!load_ring(st, v, ring)) return false;
+                     RingScratch& ring, Eigen::Vector3d* out, int searches, const RingIndex* index) {
+  if (!load_ring(st, v, ring, index)) return false;
   Eigen::Vector3d x = st.S.row(v).transpose();
   const size_t per_model = ring.faces.size() * static_cast<size_t>(st.models);
   ring.energy_here.resize(per_model);
@@ -676,6 +726,8 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
         if (w != v) *out++ = w;
       }
   });
+  RingIndex index;
+  build_ring_index(st, &workers, &index);
   auto corners = [&](int v) {
     return std::span<const int>(walk.data() + walk_start[static_cast<size_t>(v)],
                                 walk.data() + walk_start[static_cast<size_t>(v) + 1]);
@@ -708,7 +760,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
         mix(pass_key ^ mix(static_cast<std::uint64_t>(round) * 0x100000001b3ULL + static_cast<std::uint64_t>(v)));
     Eigen::Vector3d y;
     Candidate& c = cand[static_cast<size_t>(i)];
-    if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2)) {
+    if (optimize_vertex(st, v, key, s, rings[static_cast<size_t>(thread)], &y, 2, &index)) {
       c.x = y;
       c.dist = (y - st.S.row(v).transpose()).norm();
       c.moved = true;

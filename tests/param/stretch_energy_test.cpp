@@ -225,3 +225,38 @@ TEST_CASE("the Newton steps' analytic ring derivatives match differences of the 
   CHECK(compared > 100);
   CHECK(with_split > 50);
 }
+
+TEST_CASE("a ring read through the pass's ring index is the ring read from the faces", "[param][sphere][energy]") {
+  const TriMesh m = test::icosphere(2);
+  RowMat3d S = m.V;
+  S.rowwise().normalize();
+  RowMatXd P = S;
+  P.col(1) *= 2.0;
+  SphereState st = make_state(m, S, P);
+  // Mixed corner orders (v first, second and third in its faces) and a dead vertex.
+  for (size_t f = 0; f < st.F.size(); f += 3) st.F[f] = {st.F[f][2], st.F[f][0], st.F[f][1]};
+  st.vertex_alive[5] = 0;
+  RingIndex index;
+  build_ring_index(st, nullptr, &index);
+  CHECK(index.start[6] == index.start[5]);
+  int compared = 0;
+  for (int v = 0; v < static_cast<int>(S.rows()); ++v) {
+    if (!st.vertex_alive[static_cast<size_t>(v)]) continue;
+    RingScratch a, b;
+    REQUIRE(load_ring(st, v, a));
+    REQUIRE(load_ring(st, v, b, &index));
+    REQUIRE(a.faces.size() == b.faces.size());
+    for (size_t i = 0; i < a.faces.size(); ++i) {
+      CHECK(a.faces[i].f == b.faces[i].f);
+      CHECK(a.faces[i].a == b.faces[i].a);
+      CHECK(a.faces[i].b == b.faces[i].b);
+      // ccw after v: the face (v, a, b) is positively oriented on the sphere
+      CHECK(orient3d_origin(S.row(v).transpose(), S.row(b.faces[i].a).transpose(), S.row(b.faces[i].b).transpose()) > 0);
+    }
+    CHECK(a.surf == b.surf);
+    const Eigen::Vector3d x = S.row(v).transpose();
+    CHECK(ring_energy(st, a, x, 1e-4, 0.99) == ring_energy(st, b, x, 1e-4, 0.99));
+    ++compared;
+  }
+  CHECK(compared == static_cast<int>(S.rows()) - 1);
+}

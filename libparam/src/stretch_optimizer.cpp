@@ -329,35 +329,30 @@ inline double singular_cruft_term(double T, double D, double reg_weight) {
   return g > 0 ? reg_weight / (g * g * g) : kInf;
 }
 
-// Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, from the Gram entries of
-// its domain edges e1, e2 and surface edges d1, d2 (as gram_energy; the surface edges of
-// the split's halves move with the split point, so they are formed here):
-// |J|_F^2 = (E22 D11 + E11 D22 - 2 E12 D12) / Q, det J^T J = |d1 x d2|^2 / Q,
-// Q = E11 E22 - E12^2 = (2 A_dom)^2. One square root (the surface area) and no frame.
+// Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, formed explicitly.
 inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                            const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
                            double scale, double floor, double reg_weight, double weight, double shape_weight,
                            bool edge_frames) {
-  const Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
-  const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
-  if (!(E11 > 0)) return kInf;
-  const double Q = E11 * E22 - E12 * E12;
-  if (!(Q > 1e-24 * E11 * E11)) return kInf;  // chord triangle (numerically) collapsed
-  const Eigen::Vector3d d1 = p1 - p0, d2 = p2 - p0;
-  const double D11 = d1.squaredNorm(), D22 = d2.squaredNorm(), D12 = d1.dot(d2);
-  const double iQ = 1 / Q;
-  const double T = gram_frobenius_numerator(E11, E22, E12, D11, D22, D12) * scale * iQ;
-  const double cross2 = d1.cross(d2).squaredNorm();
-  const double D = cross2 * (scale * scale) * iQ;
-  double reg;
-  if (edge_frames) {
-    const Eigen::Vector3d e3 = e2 - e1, d3 = d2 - d1;
-    reg = cruft_term(T, scale * D11 / E11, scale * D22 / E22, scale * d3.squaredNorm() / e3.squaredNorm(), reg_weight);
-  } else {
-    reg = singular_cruft_term(T, D, reg_weight);
-  }
-  const double area = 0.5 * std::sqrt(cross2);
-  double e = weight * (area + floor) * (0.5 * T + reg);
+  Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
+  double l1sq = e1.squaredNorm();
+  if (!(l1sq > 0)) return kInf;
+  double l1 = std::sqrt(l1sq);
+  double e2u = e2.dot(e1) / l1;
+  double hsq = e2.squaredNorm() - e2u * e2u;
+  if (!(hsq > 1e-24 * l1sq)) return kInf;  // chord triangle (numerically) collapsed
+  double h = std::sqrt(hsq);
+  Eigen::Vector3d d1 = p1 - p0, d2 = p2 - p0;
+  Eigen::Vector3d Ss = d1 / l1;
+  Eigen::Vector3d St = (d2 - e2u * Ss) / h;
+  double a = Ss.squaredNorm() * scale, c = St.squaredNorm() * scale, b = Ss.dot(St) * scale;
+  double T = a + c, D = a * c - b * b;
+  const Eigen::Vector3d e3 = e2 - e1, d3 = d2 - d1;
+  double reg = edge_frames ? cruft_term(T, a, scale * d2.squaredNorm() / e2.squaredNorm(),
+                                        scale * d3.squaredNorm() / e3.squaredNorm(), reg_weight)
+                           : singular_cruft_term(T, D, reg_weight);
+  double area = 0.5 * d1.cross(d2).norm();
+  double e = weight * (area + floor) * (0.5 * (a + c) + reg);
   if (shape_weight != 0) e += D > 0 ? 0.5 * shape_weight * (0.5 * T / std::sqrt(D)) : kInf;
   return e;
 }

@@ -411,37 +411,61 @@ inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, 
   }
   return e;
 }
-}  // namespace
 
+// A ring face with v at y: its domain edges from y and whether it takes the accordion split.
+// Distance of the chord plane from the centre: 1 for tiny triangles, 1/3 for the faces of a
+// regular tetrahedron, -> 0 when the corners approach one great circle. Large faces (chord
+// plane closer than split_distance) take the split evaluation, the others the cheap Gram form.
+struct FacePlace {
+  Eigen::Vector3d e1, e2;  // qa - y, qb - y
+  double cross2;           // |e1 x e2|^2
+  bool large;
+};
+
+// False where y is outside the face's kernel (det[y, qa, qb] <= 0).
+inline bool place_face(const RingScratch::Face& rf, const Eigen::Vector3d& y, double split_distance, FacePlace* out) {
+  out->e1 = rf.qa - y;
+  out->e2 = rf.qb - y;
+  const double det = y.dot(rf.n);
+  if (!(det > 0)) return false;
+  // delta < split_distance, without a square root: det^2 < split^2 |e1 x e2|^2.
+  out->cross2 = out->e1.cross(out->e2).squaredNorm();
+  out->large = det * det < split_distance * split_distance * out->cross2;
+  return true;
+}
+
+// One placed face's energy for one model (`s`: its record in RingScratch::surf).
+inline double placed_face_energy(const SphereState& st, const RingScratch::Face& rf, const FacePlace& fp,
+                                 const double* s, double scale, const Eigen::Vector3d& y, double reg_weight) {
+  if (!fp.large) return gram_energy(fp.e1, fp.e2, s, scale, reg_weight, st.edge_frame_cruft);
+  const Eigen::Vector3d q[3] = {y, rf.qa, rf.qb};
+  const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
+                                Eigen::Vector3d(s[6], s[7], s[8])};
+  return split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
+}
+
+// One ring face's energy for one model with v at y, without the hole-area term.
+double face_model_energy(const SphereState& st, const RingScratch::Face& rf, const double* s, double scale,
+                         const Eigen::Vector3d& y, double reg_weight, double split_distance) {
+  FacePlace fp;
+  if (!place_face(rf, y, split_distance, &fp)) return kInf;
+  return placed_face_energy(st, rf, fp, s, scale, y, reg_weight);
+}
+
+}  // namespace
 
 double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x, double reg_weight,
                    double split_distance, double* face_energy) {
   double energy = 0;
   for (size_t i = 0; i < ring.faces.size(); ++i) {
     const auto& rf = ring.faces[i];
-    const Eigen::Vector3d e1 = rf.qa - x, e2 = rf.qb - x;
-    // Distance of the chord plane from the centre: 1 for tiny triangles, 1/3 for the faces of
-    // a regular tetrahedron, -> 0 when the corners approach one great circle. Large faces
-    // (chord plane closer than split_distance) take the split evaluation, the others the cheap Gram form.
-    const double det = x.dot(rf.n);
-    if (!(det > 0)) return kInf;
-    // delta < split_distance, without a square root: det^2 < split^2 |e1 x e2|^2.
-    const double cross2 = e1.cross(e2).squaredNorm();
-    const bool large = det * det < split_distance * split_distance * cross2;
-    if (rf.real && st.hole_area_penalty > 0) energy += st.hole_area_penalty * 0.5 * std::sqrt(cross2);
+    FacePlace fp;
+    if (!place_face(rf, x, split_distance, &fp)) return kInf;
+    if (rf.real && st.hole_area_penalty > 0) energy += st.hole_area_penalty * 0.5 * std::sqrt(fp.cross2);
     for (int m = 0; m < st.models; ++m) {
       const size_t k = i * static_cast<size_t>(st.models) + static_cast<size_t>(m);
-      const double* s = &ring.surf[k * kSurfStride];
-      const double scale = st.model_scale[static_cast<size_t>(m)];
-      double e;
-      if (!large) {
-        e = gram_energy(e1, e2, s, scale, reg_weight, st.edge_frame_cruft);
-      } else {
-        const Eigen::Vector3d q[3] = {x, rf.qa, rf.qb};
-        const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
-                                      Eigen::Vector3d(s[6], s[7], s[8])};
-        e = split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
-      }
+      const double e = placed_face_energy(st, rf, fp, &ring.surf[k * kSurfStride],
+                                          st.model_scale[static_cast<size_t>(m)], x, reg_weight);
       if (face_energy) face_energy[k] = e;
       energy += e;
     }
@@ -449,26 +473,6 @@ double ring_energy(const SphereState& st, const RingScratch& ring, const Eigen::
   }
   return energy;
 }
-
-namespace {
-
-// One ring face's energy for one model with v at y (ring_energy's per-face rule, without the
-// hole-area term): the accordion split where the chord plane is closer than split_distance.
-double face_model_energy(const SphereState& st, const RingScratch::Face& rf, const double* s, double scale,
-                         const Eigen::Vector3d& y, double reg_weight, double split_distance) {
-  const Eigen::Vector3d e1 = rf.qa - y, e2 = rf.qb - y;
-  const double det = y.dot(rf.n);
-  if (!(det > 0)) return kInf;
-  const double cross2 = e1.cross(e2).squaredNorm();
-  if (!(det * det < split_distance * split_distance * cross2))
-    return gram_energy(e1, e2, s, scale, reg_weight, st.edge_frame_cruft);
-  const Eigen::Vector3d q[3] = {y, rf.qa, rf.qb};
-  const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
-                                Eigen::Vector3d(s[6], s[7], s[8])};
-  return split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
-}
-
-}  // namespace
 
 bool ring_tangent_derivatives(const SphereState& st, const RingScratch& ring, const Eigen::Vector3d& x,
                               const Eigen::Vector3d& t1, const Eigen::Vector3d& t2, double h, double reg_weight,
@@ -481,11 +485,11 @@ bool ring_tangent_derivatives(const SphereState& st, const RingScratch& ring, co
   bool have_stencil = false;
   for (size_t i = 0; i < ring.faces.size(); ++i) {
     const auto& rf = ring.faces[i];
-    const Eigen::Vector3d e1 = rf.qa - x, e2 = rf.qb - x;
-    const double det = x.dot(rf.n);
-    if (!(det > 0)) return false;
-    const double cross2 = e1.cross(e2).squaredNorm();
-    const bool large = det * det < split_distance * split_distance * cross2;
+    FacePlace fp;
+    if (!place_face(rf, x, split_distance, &fp)) return false;
+    const Eigen::Vector3d& e1 = fp.e1;
+    const Eigen::Vector3d& e2 = fp.e2;
+    const bool large = fp.large;
     const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
     GramJet face;
     if (rf.real && st.hole_area_penalty > 0) {

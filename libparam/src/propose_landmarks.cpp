@@ -11,6 +11,10 @@
 #include <queue>
 #include <string>
 
+#include "detail/landmark_orientation.h"
+#include "spherekit/constrained_param.h"
+#include "spherekit/sphere_param.h"
+
 namespace spherekit {
 namespace {
 
@@ -22,6 +26,7 @@ struct MeshGraph {
   std::vector<double> len;
   RowMat3d N;
   double sqrt_area = 1;
+  std::vector<double> varea;  // a third of the incident faces' areas, / total area
 };
 
 Result<MeshGraph> build_graph(const TriMesh& m, int index) {
@@ -32,6 +37,7 @@ Result<MeshGraph> build_graph(const TriMesh& m, int index) {
   edges.reserve(m.F.rows() * 6);
   MeshGraph g;
   g.N = RowMat3d::Zero(n, 3);
+  g.varea.assign(n, 0.0);
   double area = 0;
   for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
     for (int c = 0; c < 3; ++c) {
@@ -44,10 +50,14 @@ Result<MeshGraph> build_graph(const TriMesh& m, int index) {
     const Eigen::Vector3d e2 = m.V.row(m.F(f, 2)) - m.V.row(m.F(f, 0));
     const Eigen::Vector3d cr = e1.cross(e2);  // area-weighted normal
     area += 0.5 * cr.norm();
-    for (int c = 0; c < 3; ++c) g.N.row(m.F(f, c)) += cr.transpose();
+    for (int c = 0; c < 3; ++c) {
+      g.N.row(m.F(f, c)) += cr.transpose();
+      g.varea[m.F(f, c)] += cr.norm() / 6;
+    }
   }
   if (!(area > 0) || !std::isfinite(area)) return Result<MeshGraph>(ErrorCode::InvalidInput, who + "zero or non-finite area");
   g.sqrt_area = std::sqrt(area);
+  for (double& a : g.varea) a /= area;
   for (int v = 0; v < n; ++v) {
     const double l = g.N.row(v).norm();
     if (l > 0) g.N.row(v) /= l;
@@ -167,6 +177,36 @@ Status find_extremities(const TriMesh& mesh, int index, const ProposeLandmarksOp
   return Status::ok_status();
 }
 
+// The centre of an extremity's tip region: the vertices within `radius` of it whose AGD is
+// within `drop` of its own (a hand's fingertips: nearly equal peaks whose order changes from
+// pose to pose, FAUST 027 and 041 peak at the little finger, 000 and 013 at the middle one).
+// The region's centroid, each vertex weighted by its area and by how far its AGD rises above
+// the region's floor (so the centre moves smoothly as the AGD estimate's noise moves the
+// floor), and the region's vertex nearest to it.
+int tip_centre(const TriMesh& mesh, const Member& m, int f, double radius, double drop) {
+  const int e = m.ext[f];
+  const double floor = m.agd[e] - drop;
+  std::vector<int> region;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  double wsum = 0;
+  for (int v = 0; v < static_cast<int>(m.agd.size()); ++v)
+    if (m.dist[f][v] < radius && m.agd[v] > floor) {
+      const double w = m.g.varea[v] * (m.agd[v] - floor);
+      c += w * mesh.V.row(v).transpose();
+      wsum += w;
+      region.push_back(v);
+    }
+  if (!(wsum > 0)) return e;
+  c /= wsum;
+  int best = e;
+  double best_d = kInf;
+  for (int v : region) {
+    const double d = (mesh.V.row(v).transpose() - c).squaredNorm();
+    if (d < best_d) best_d = d, best = v;
+  }
+  return best;
+}
+
 // Orientation of every triple (i<j<k) of a member's points: seen from a centre vertex c, the
 // directions towards the three points turn counter-clockwise about the outward
 // normal (> 0) or clockwise (< 0). The value is the signed area of the triangle of the three
@@ -204,15 +244,27 @@ struct Assignment {
   std::vector<int> to;  // reference extremity -> member extremity index or -1
 };
 
-// Branch and bound over partial injective assignments. A pair of matched points costs
-// min(|d_ref - d_member|, cap); a pair with an unmatched point costs cap, so leaving a point
-// out is never cheaper than a bad match and a missing extremity (an ear too small to be one on
-// some member) does not force a wrong one. Keeps the `keep` cheapest complete assignments.
+// |log ratio| beyond this (a factor 1.5) a pair of distances is simply "wrong".
+constexpr double kPairCap = 0.4;
+// Weight of the disc-area profile in a point's unary cost, and what an unmatched point pays
+// instead (the most a matched one can: the profile's and the AGD's caps).
+constexpr double kProfileWeight = 2.0;
+constexpr double kUnaryMiss = (kProfileWeight + 1.0) * kPairCap;
+
+// Branch and bound over partial injective assignments. A pair of matched points costs the
+// relative difference of their distances, min(|log(d_ref / d_member)|, cap): the poses of a
+// family are only nearly isometric, and a limb that is bent or stretched changes its long
+// distances by more than its short ones in absolute terms but by about the same factor
+// (FAUST bodies: hand-to-hand geodesics differ by 40 % between poses of one family). A pair
+// with an unmatched point costs cap, so leaving a point out is never cheaper than a bad match
+// and a missing extremity (an ear too small to be one on some member) does not force a wrong
+// one. Each matched point also pays its unary cost U[i][j] (its own isometry-invariant
+// description; an unmatched one pays kUnaryMiss). Keeps the `keep` cheapest complete assignments.
 class Matcher {
  public:
   Matcher(const std::vector<std::vector<double>>& R, const std::vector<std::vector<double>>& M,
-          const std::vector<double>& agd_r, const std::vector<double>& agd_m, int keep)
-      : R_(R), M_(M), agd_r_(agd_r), agd_m_(agd_m), keep_(keep), kr_(static_cast<int>(R.size())), km_(static_cast<int>(M.size())) {}
+          const std::vector<std::vector<double>>& U, int keep)
+      : R_(R), M_(M), U_(U), keep_(keep), kr_(static_cast<int>(R.size())), km_(static_cast<int>(M.size())) {}
   std::vector<Assignment> run() {
     cur_.assign(kr_, -1);
     used_.assign(km_, false);
@@ -222,7 +274,10 @@ class Matcher {
     });
     return best_;
   }
-  static constexpr double kCap = 0.25;  // x sqrt(area): beyond this a pair is simply "wrong"
+  static constexpr double kCap = kPairCap;
+  static double pair_cost(double a, double b) {
+    return a > 0 && b > 0 ? std::min(std::abs(std::log(a / b)), kCap) : kCap;
+  }
 
  private:
   double bound() const { return static_cast<int>(best_.size()) < keep_ ? kInf : best_.back().cost; }
@@ -238,11 +293,8 @@ class Matcher {
     std::vector<std::pair<double, int>> opts;
     for (int j = -1; j < km_; ++j) {
       if (j >= 0 && used_[j]) continue;
-      // The point's own AGD (isometry-invariant like the distances) tells a head from a limb tip
-      // at similar distances; weighted as one more pair.
-      double add = j < 0 ? kCap : std::min(std::abs(agd_r_[i] - agd_m_[j]), kCap);
-      for (int p = 0; p < i; ++p)
-        add += (j < 0 || cur_[p] < 0) ? kCap : std::min(std::abs(R_[i][p] - M_[j][cur_[p]]), kCap);
+      double add = j < 0 ? kUnaryMiss : U_[i][j];
+      for (int p = 0; p < i; ++p) add += (j < 0 || cur_[p] < 0) ? kCap : pair_cost(R_[i][p], M_[j][cur_[p]]);
       opts.emplace_back(add, j);
     }
     std::sort(opts.begin(), opts.end());
@@ -256,8 +308,7 @@ class Matcher {
   }
   const std::vector<std::vector<double>>& R_;
   const std::vector<std::vector<double>>& M_;
-  const std::vector<double>& agd_r_;
-  const std::vector<double>& agd_m_;
+  const std::vector<std::vector<double>>& U_;
   int keep_, kr_, km_;
   long nodes_ = 0;
   std::vector<int> cur_;
@@ -273,10 +324,35 @@ std::vector<std::vector<double>> pair_distances(const Member& m) {
   return D;
 }
 
-std::vector<double> ext_agd(const Member& m) {
-  std::vector<double> a;
-  for (int e : m.ext) a.push_back(m.agd[e]);
-  return a;
+// Per extremity: the share of the surface within geodesic radius r of it, for a few radii: a
+// thin limb tip, a paw and a head differ in how fast their discs fill even where their
+// distances to the other extremities agree (a cat's head and front paws form a near
+// equilateral triangle). Isometry invariant, like the distances.
+std::vector<std::vector<double>> disc_profiles(const Member& m) {
+  static constexpr double kRadii[] = {0.05, 0.1, 0.15, 0.2, 0.3, 0.4};  // x sqrt(area)
+  std::vector<std::vector<double>> out;
+  for (std::size_t e = 0; e < m.ext.size(); ++e) {
+    std::vector<double> a(std::size(kRadii), 0.0);
+    for (std::size_t v = 0; v < m.g.varea.size(); ++v)
+      for (std::size_t r = 0; r < std::size(kRadii); ++r)
+        if (m.dist[e][v] < kRadii[r]) a[r] += m.g.varea[v];
+    out.push_back(a);
+  }
+  return out;
+}
+
+// Unary costs U[i][j] of matching the reference's extremity i to the member's j: relative
+// differences of the disc profiles and of the AGD values, each capped like a pair.
+std::vector<std::vector<double>> unary_costs(const Member& r, const Member& m) {
+  const auto pr = disc_profiles(r), pm = disc_profiles(m);
+  std::vector<std::vector<double>> U(r.ext.size(), std::vector<double>(m.ext.size(), 0.0));
+  for (std::size_t i = 0; i < r.ext.size(); ++i)
+    for (std::size_t j = 0; j < m.ext.size(); ++j) {
+      double d = 0;
+      for (std::size_t k = 0; k < pr[i].size(); ++k) d += Matcher::pair_cost(pr[i][k], pm[j][k]);
+      U[i][j] = kProfileWeight * d / static_cast<double>(pr[i].size()) + Matcher::pair_cost(r.agd[r.ext[i]], m.agd[m.ext[j]]);
+    }
+  return U;
 }
 
 // Agreement -1..1 of the turns of the matched triples of the reference and the member.
@@ -301,11 +377,34 @@ double orientation_agreement(const std::vector<double>& tr, const std::vector<do
   return den > 0 ? num / den : 0.0;
 }
 
+// An assignment with the orientation agreement of its matched triples.
+struct Candidate {
+  Assignment a;
+  double turn = 0;
+};
+
 struct MatchAll {
   std::vector<LandmarkMemberMatch> members;
   std::vector<std::vector<int>> to;  // per member: reference extremity -> member extremity (-1: none)
+  std::vector<std::vector<Candidate>> cands;  // per member: the cheapest assignments, by cost
   double total = 0;                  // sum of the members' mean costs
 };
+
+// Two assignments are "about as good" when their mean pair error differs by less than this
+// (relative distance error, the size of the AGD maxima's placement noise between poses).
+constexpr double kClose = 0.01;
+// The assignments the sphere test compares: within this mean pair error of the cheapest (the
+// mirror twins of a near-symmetric shape and their variants; on TOSCA cats with six
+// extremities the right one was the 8th cheapest, 0.032 above the cheapest), at most
+// kSphereCandidates of them (each costs one constrained map of the member).
+constexpr double kSphereWindow = 0.05;
+constexpr int kSphereCandidates = 8;
+// Weight of the log efficiency ratio beside the signal correlation. The decisions on the
+// shared cats and FAUST bodies were the same for every weight from 0.2 to 0.5 (at 1 the
+// efficiency overrules the signal on FAUST, where a turned-round body costs little stretch).
+constexpr double kEfficiencyWeight = 0.35;
+// Agreements (correlations) closer than this do not decide.
+constexpr double kSphereMargin = 0.05;
 
 // Every member matched to the reference `ref` (which has at least 3 extremities).
 MatchAll match_all(const std::vector<TriMesh>& meshes, const std::vector<Member>& mem, int ref) {
@@ -317,25 +416,28 @@ MatchAll match_all(const std::vector<TriMesh>& meshes, const std::vector<Member>
   const auto Rd = pair_distances(rm);
   const int rc = static_cast<int>(std::min_element(rm.agd.begin(), rm.agd.end()) - rm.agd.begin());
   const auto Rt = triple_turns(meshes[ref], rm, rm.ext, rc);
+  const double pairs = kr * (kr + 1) / 2.0;  // the pairs and the unary terms
 
   MatchAll ma;
   ma.members.resize(nm);
   ma.to.assign(nm, {});
+  ma.cands.assign(nm, {});
   ma.to[ref] = ref_fields;
   for (int i = 0; i < nm; ++i) {
     if (i == ref) continue;
     const Member& m = mem[i];
     const int km = static_cast<int>(m.ext.size());
-    auto cands = Matcher(Rd, pair_distances(m), ext_agd(rm), ext_agd(m), 64).run();
-    const double pairs = kr * (kr + 1) / 2.0;  // the pairs and the unary AGD terms
-    // The cheapest assignment turning each way; a shape and its mirror image have the same
-    // distances, so for a (near-)symmetric shape both are among the cheapest.
-    const Assignment* pos = nullptr;
-    const Assignment* neg = nullptr;
-    double opos = 0, oneg = 0;
+    const auto Md = pair_distances(m);
+    const auto U = unary_costs(rm, m);
+    const auto found = Matcher(Rd, Md, U, 64).run();
+    // The orientation of each assignment's matched triples (seen from the reference's centre
+    // located on the member through that assignment), for the assignments the choice below
+    // reads: those in the sphere test's window and the cheapest of each orientation.
+    std::vector<Candidate>& cands = ma.cands[i];
     std::vector<std::pair<int, std::vector<double>>> turns_by_centre;  // a centre's turns, computed once
-    for (const auto& a : cands) {
-      if (pos && neg) break;  // only the cheapest of each orientation is used
+    bool seen_pos = false, seen_neg = false;
+    for (const auto& a : found) {
+      if (seen_pos && seen_neg && a.cost > found.front().cost + kSphereWindow * pairs) break;
       // The reference's centre on this member: the vertex whose distances to the assigned
       // extremities best fit the reference centre's (geodesic trilateration).
       int c = 0;
@@ -352,36 +454,124 @@ MatchAll match_all(const std::vector<TriMesh>& meshes, const std::vector<Member>
         it = turns_by_centre.end() - 1;
       }
       const double ag = orientation_agreement(Rt, it->second, kr, km, a.to);
-      if (ag >= 0 && !pos) pos = &a, opos = ag;
-      if (ag < 0 && !neg) neg = &a, oneg = ag;
+      (ag >= 0 ? seen_pos : seen_neg) = true;
+      cands.push_back({a, ag});
+    }
+    // The choice by turns (kept where no sphere maps can be made): the cheapest assignment
+    // turning each way; a shape and its mirror image have the same distances, so for a
+    // (near-)symmetric shape both are among the cheapest.
+    const Candidate* pos = nullptr;
+    const Candidate* neg = nullptr;
+    for (const auto& c : cands) {
+      if (c.turn >= 0 && !pos) pos = &c;
+      if (c.turn < 0 && !neg) neg = &c;
     }
     LandmarkMemberMatch& mm = ma.members[i];
-    // Two assignments are "about as good" when their mean pair error differs by less than
-    // 0.01 sqrt(area): the size of the AGD maxima's placement noise between poses.
-    const double close = 0.01 * pairs;
-    const Assignment* pick = pos ? pos : neg;
+    const double close = kClose * pairs;
+    const Candidate* pick = pos ? pos : neg;
     if (pos && neg) {
-      if (pos->cost <= neg->cost + close) {
+      if (pos->a.cost <= neg->a.cost + close) {
         pick = pos;
-        mm.mirror_resolved = neg->cost < pos->cost;
+        mm.mirror_resolved = neg->a.cost < pos->a.cost;
       } else {
         pick = neg;  // intrinsically clearly best, but it turns the other way: a mirrored member
         mm.mirrored = true;
       }
-      mm.mirrored_cost = (pick == pos ? neg->cost : pos->cost) / pairs;
+      mm.mirrored_cost = (pick == pos ? neg->a.cost : pos->a.cost) / pairs;
     } else if (neg) {
       mm.mirrored = true;
     }
-    mm.cost = pick->cost / pairs;
-    mm.orientation_agreement = pick == pos ? opos : oneg;
+    mm.cost = pick->a.cost / pairs;
+    mm.orientation_agreement = pick->turn;
     // Orientation too weak to decide (flat or degenerate triples), with a near-equal rival.
-    const double other = pick == pos ? (neg ? neg->cost : kInf) : (pos ? pos->cost : kInf);
-    if (std::abs(mm.orientation_agreement) < 0.3 && other - pick->cost < close) mm.mirror_ambiguous = true;
-    if (mm.mirrored && other - pick->cost < close) mm.mirror_ambiguous = true;
-    ma.to[i] = pick->to;
+    const double other = pick == pos ? (neg ? neg->a.cost : kInf) : (pos ? pos->a.cost : kInf);
+    if (std::abs(mm.orientation_agreement) < 0.3 && other - pick->a.cost < close) mm.mirror_ambiguous = true;
+    if (mm.mirrored && other - pick->a.cost < close) mm.mirror_ambiguous = true;
+    ma.to[i] = pick->a.to;
     ma.total += mm.cost;
   }
   return ma;
+}
+
+// The sphere test (detail/landmark_orientation.h): the reference's unconstrained map places
+// its extremities; every assignment in a member's window becomes a constrained map of the
+// member with its matched extremities there, and the one whose correspondence carries the
+// reference's signed shape signal best onto the member's is kept. Members whose maps cannot
+// be made (not genus 0, a failed network) keep the choice by turns. Returns false when
+// cancelled.
+bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Member>& mem, int ref,
+                       const ProposeLandmarksOptions& o, MatchAll& ma, const ProgressFn& progress) {
+  constexpr double kSignalRadius = 0.15;  // x sqrt(area): face vs back of a head, toes vs heels
+  const int nm = static_cast<int>(meshes.size());
+  const Member& rm = mem[ref];
+  const int kr = static_cast<int>(rm.ext.size());
+  const double pairs = kr * (kr + 1) / 2.0;
+  SphereParamOptions so;
+  so.effort = o.sphere_effort;
+  so.threads = o.threads;
+  auto base = parameterize_sphere(meshes[ref], so);
+  if (!base.ok() || base->flipped_faces != 0) return true;
+  const RowMat3d& S_ref = base->map.S;
+  const std::vector<double> h_ref = detail::smoothed_normal_offset(meshes[ref], kSignalRadius);
+  for (int i = 0; i < nm; ++i) {
+    if (i == ref || ma.cands[i].empty()) continue;
+    const std::vector<Candidate>& cands = ma.cands[i];
+    const std::vector<double> h = detail::smoothed_normal_offset(meshes[i], kSignalRadius);
+    const double limit = cands.front().a.cost + kSphereWindow * pairs;
+    std::vector<std::pair<double, int>> scored;  // (agreement, candidate)
+    std::vector<double> effs;
+    for (int c = 0; c < static_cast<int>(cands.size()) && static_cast<int>(scored.size()) < kSphereCandidates; ++c) {
+      if (cands[c].a.cost > limit) break;
+      std::vector<int> fv;
+      std::vector<Eigen::Vector3d> targets;
+      for (int q = 0; q < kr; ++q)
+        if (cands[c].a.to[q] >= 0) {
+          fv.push_back(mem[i].ext[cands[c].a.to[q]]);
+          targets.push_back(S_ref.row(rm.ext[q]).transpose());
+        }
+      ConstrainedParamOptions co;
+      co.sphere = so;
+      auto map = parameterize_sphere_constrained(meshes[i], fv, targets, co);
+      double agree = -2, eff = 0;
+      if (map.ok() && map->flipped_faces == 0) {
+        agree = detail::correspondence_agreement(meshes[ref], S_ref, h_ref, meshes[i], map->map.S, h);
+        eff = map->efficiency;
+      }
+      scored.emplace_back(agree, c);
+      effs.push_back(eff);
+      if (!report_progress(progress, "landmarks", i, 0.9)) return false;
+    }
+    // A swapped assignment also costs the member's map stretch: the constraints lay the limbs
+    // out the other way round from where the member's own shape puts them (as the reference's
+    // unconstrained map does for the reference). Both signals add: the correlation, and half
+    // the log of the efficiency relative to the best candidate's.
+    const double best_eff = *std::max_element(effs.begin(), effs.end());
+    for (std::size_t k = 0; k < scored.size(); ++k)
+      if (scored[k].first > -2) scored[k].first += kEfficiencyWeight * std::log(std::max(effs[k], 1e-12) / best_eff);
+    std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) {
+      return x.first != y.first ? x.first > y.first : x.second < y.second;
+    });
+    if (scored.empty() || scored.front().first <= -2) continue;  // no map: the choice by turns stands
+    const Candidate& pick = cands[scored.front().second];
+    LandmarkMemberMatch& mm = ma.members[i];
+    ma.total += pick.a.cost / pairs - mm.cost;
+    mm.sphere_checked = true;
+    mm.sphere_agreement = scored.front().first;
+    mm.sphere_runner_up = scored.size() > 1 ? scored[1].first : -2;
+    mm.cost = pick.a.cost / pairs;
+    mm.orientation_agreement = pick.turn;
+    // The cheapest assignment needs a turned-round body: if it is clearly cheaper than the
+    // pick, the member is a mirror image (intrinsically best only reflected); if not, the
+    // shape is (nearly) symmetric and its left/right was settled here.
+    const double cheapest = cands.front().a.cost;
+    mm.mirrored = pick.a.cost - cheapest > kClose * pairs;
+    mm.mirror_resolved = !mm.mirrored && scored.front().second != 0;
+    mm.mirrored_cost = scored.size() > 1 ? cands[scored[1].second].a.cost / pairs : -1;
+    // Two candidates the signal cannot tell apart: flagged, not guessed.
+    mm.mirror_ambiguous = scored.size() > 1 && scored.front().first - scored[1].first < kSphereMargin;
+    ma.to[i] = pick.a.to;
+  }
+  return true;
 }
 
 }  // namespace
@@ -394,8 +584,11 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   if (o.agd_sources < 4 || o.agd_sources > 1000) return R(ErrorCode::InvalidArgument, "agd_sources must be 4..1000");
   if (o.max_extremities < 3 || o.max_extremities > 16) return R(ErrorCode::InvalidArgument, "max_extremities must be 3..16");
   if (!(o.extremity_radius > 0 && o.extremity_radius < 1)) return R(ErrorCode::InvalidArgument, "extremity_radius must be in (0, 1)");
+  if (!(o.tip_drop >= 0 && o.tip_drop < 1)) return R(ErrorCode::InvalidArgument, "tip_drop must be in [0, 1)");
   if (o.extra_points < 0 || o.extra_points > 1000) return R(ErrorCode::InvalidArgument, "extra_points must be 0..1000");
   if (o.reference < -1 || o.reference >= nm) return R(ErrorCode::InvalidArgument, "reference out of range");
+  if (o.sphere_effort < 0 || o.sphere_effort > 5) return R(ErrorCode::InvalidArgument, "sphere_effort must be 0..5");
+  if (o.threads < 0) return R(ErrorCode::InvalidArgument, "threads must be >= 0");
 
   std::vector<Member> mem(nm);
   for (int i = 0; i < nm; ++i) {
@@ -421,6 +614,8 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     }
     if (ref < 0) return R(ErrorCode::InvalidInput, "no mesh has 3 extremities");
   }
+  if (o.sphere_orientation && !resolve_by_sphere(meshes, mem, ref, o, ma, progress))
+    return R(ErrorCode::Cancelled, "cancelled");
   Member& rm = mem[ref];
   const int kr = static_cast<int>(rm.ext.size());
   ProposeLandmarksResult out;
@@ -437,6 +632,18 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     if (all) keep.push_back(e);
   }
   if (keep.size() < 3) return R(ErrorCode::InvalidInput, "fewer than 3 extremities correspond across all members");
+  // Each kept extremity moved to the centre of its tip region (see tip_centre), on every member
+  // alike, and its distance field recomputed.
+  if (o.tip_drop > 0)
+    for (int i = 0; i < nm; ++i)
+      for (int e : keep) {
+        const int f = to[i][e];
+        const int c = tip_centre(meshes[i], mem[i], f, o.extremity_radius, o.tip_drop);
+        if (c != mem[i].ext[f]) {
+          mem[i].ext[f] = c;
+          dijkstra(mem[i].g, c, mem[i].dist[f], &mem[i].parent[f]);
+        }
+      }
   out.landmarks.assign(nm, {});
   out.confidence.assign(nm, {});
   // anchors[i]: per landmark, the index of its distance field in mem[i].dist.

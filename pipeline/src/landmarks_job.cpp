@@ -59,7 +59,10 @@ Json to_json(const LandmarksJob& job, const LandmarksResult& r) {
   j["options"] = {{"agd_sources", job.options.agd_sources},
                   {"max_extremities", job.options.max_extremities},
                   {"extremity_radius", job.options.extremity_radius},
-                  {"extra_points", job.options.extra_points}};
+                  {"tip_drop", job.options.tip_drop},
+                  {"extra_points", job.options.extra_points},
+                  {"sphere_orientation", job.options.sphere_orientation},
+                  {"sphere_effort", job.options.sphere_effort}};
   Json members = Json::array();
   for (std::size_t i = 0; i < job.meshes.size(); ++i) {
     const LandmarkMemberMatch& m = p.members[i];
@@ -71,7 +74,10 @@ Json to_json(const LandmarksJob& job, const LandmarksResult& r) {
                {"orientation_agreement", m.orientation_agreement},
                {"mirror_resolved", m.mirror_resolved},
                {"mirrored", m.mirrored},
-               {"mirror_ambiguous", m.mirror_ambiguous}};
+               {"mirror_ambiguous", m.mirror_ambiguous},
+               {"sphere_checked", m.sphere_checked},
+               {"sphere_agreement", number_or_null(m.sphere_checked ? m.sphere_agreement : std::nan(""))},
+               {"sphere_runner_up", number_or_null(m.sphere_checked && m.sphere_runner_up > -2 ? m.sphere_runner_up : std::nan(""))}};
     Json lms = Json::array();
     for (std::size_t k = 0; k < p.landmarks[i].size(); ++k)
       lms.push_back({{"name", p.landmarks[i][k].name},

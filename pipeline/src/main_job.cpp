@@ -290,6 +290,7 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
       LandmarksJob lj;
       lj.meshes = inputs;
       lj.output_dir = (out_dir / "landmarks").string();
+      lj.options.threads = a.options.threads;
       auto lr = propose_landmark_files(lj, observer.progress("landmarks"));
       if (lr.status().code() == ErrorCode::Cancelled) return lr.status();
       if (!lr.ok()) {

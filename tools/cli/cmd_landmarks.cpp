@@ -38,7 +38,7 @@ int run_landmarks(const LandmarksArgs& a) {
     double low = 1;
     for (double c : p.confidence[i]) low = std::min(low, c);
     std::printf("  %s -> %s: cost %.4f, lowest confidence %.2f%s%s%s\n", a.job.meshes[i].c_str(), r->files[i].c_str(),
-                m.cost, low, m.mirror_resolved ? ", mirror flip resolved by orientation" : "",
+                m.cost, low, m.mirror_resolved ? ", left/right settled by orientation" : "",
                 m.mirrored ? ", appears MIRRORED" : "", m.mirror_ambiguous ? ", left/right AMBIGUOUS: check on the page" : "");
   }
   return 0;
@@ -52,8 +52,11 @@ void register_landmarks(CLI::App& app) {
       app, "landmarks", "Propose corresponding landmarks for a set of meshes (NAME.lm.txt files)",
       "Finds the extremities of every mesh (maxima of the average geodesic distance: limb tips,\n"
       "head, tail, ears), matches them across the meshes by their pairwise geodesic distances\n"
-      "(normalised by sqrt(area)), resolves left/right mirror flips by the orientation of matched\n"
-      "triples, optionally adds --extra-points further points (farthest-point sampling, located by\n"
+      "(relative differences, normalised by sqrt(area)) and the area of their geodesic discs,\n"
+      "settles left/right by sphere maps (each near-equal assignment becomes a constrained map;\n"
+      "the one carrying the reference's shape best onto the member's wins: a left/right swap\n"
+      "turns the body round; without sphere maps, or for meshes that are not genus 0, by the\n"
+      "turns of matched triples), optionally adds --extra-points further points (farthest-point sampling, located by\n"
       "their distances to the matched ones), and writes one `NAME.lm.txt` per mesh (beside it, or\n"
       "in --output-dir), the format `consistent` reads. --report writes every match's confidence;\n"
       "members whose left/right cannot be told are flagged there and in the summary.",
@@ -70,6 +73,14 @@ void register_landmarks(CLI::App& app) {
   cmd->add_option("--agd-sources", o.agd_sources, "sources of the average-geodesic-distance estimate")->check(CLI::Range(4, 1000));
   cmd->add_option("--extremity-radius", o.extremity_radius, "an extremity dominates this geodesic disc (x sqrt(area))")
       ->check(CLI::Range(0.001, 0.999));
+  cmd->add_option("--tip-drop", o.tip_drop,
+                  "move each extremity to the centre of its tip region: AGD within this of its peak (x sqrt(area); 0: the peak)")
+      ->check(CLI::Range(0.0, 0.999));
+  cmd->add_flag("--no-sphere-orientation{false}", o.sphere_orientation,
+                "settle left/right by the turns of matched triples only, without sphere maps");
+  cmd->add_option("--sphere-effort", o.sphere_effort, "effort of the sphere maps that settle left/right")->check(CLI::Range(0, 5));
+  cmd->add_option("--threads", o.threads, "worker threads of those maps, 0 = all cores (results do not depend on it)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args] { set_exit_code(run_landmarks(*args)); });
 }
 

@@ -9,11 +9,19 @@
 // 2. Matching without user input: an assignment of the reference member's extremities to each
 //    member's (partial, injective) minimising the differences of their pairwise geodesic
 //    distances normalised by sqrt(area), enumerated with branch and bound.
-// 3. Mirror: intrinsic distances cannot tell a shape from its mirror image; the orientation
-//    of triples of matched points (the turn from one tangent direction to another about the
-//    outward normal) can. Among the best assignments the one whose triples turn the same way
-//    as the reference's is taken; when orientation cannot decide and the mirrored assignment
-//    costs about the same, the member is flagged `mirror_ambiguous` (never guessed silently).
+// 3. Mirror: intrinsic distances cannot tell a shape from its mirror image, nor a
+//    near-symmetric shape's left from its right. Sphere maps can (they preserve orientation):
+//    the reference's unconstrained map places its extremities, each near-equal assignment of
+//    a member becomes a constrained map with its extremities there (Asirvatham, Praun, Hoppe
+//    2005 §4), and the one whose correspondence carries the reference's signed shape signal
+//    (smoothed offset along the normal) best onto the member's wins. A left/right swap can
+//    only be realised by turning the body round, face onto the back of the head.
+//    Where no sphere map can be made (not genus 0), the orientation of triples of matched
+//    points seen from a trilaterated centre decides. Members where neither decides are
+//    flagged `mirror_ambiguous` (never guessed silently).
+//    Each matched extremity then moves to the centre of its tip region (the AGD within
+//    `tip_drop` of its maximum): a hand's nearly equal fingertip peaks trade places between
+//    poses, the centre of the hand's tip does not.
 // 4. Further points by farthest-point sampling on the reference, located on every member by
 //    their geodesic distances to the points already matched.
 #pragma once
@@ -32,8 +40,12 @@ struct ProposeLandmarksOptions {
   int agd_sources = 24;          ///< farthest-point sources of the AGD estimate (>= 4)
   int max_extremities = 10;      ///< at most this many extremities per member (3..16)
   double extremity_radius = 0.15;  ///< an extremity dominates the AGD on this geodesic disc (x sqrt(area))
+  double tip_drop = 0.03;        ///< a matched extremity moves to the centre of its tip region: AGD within this of its own (x sqrt(area)); 0: stays at the AGD maximum
   int extra_points = 0;          ///< further points by farthest-point sampling (>= 0)
   int reference = -1;            ///< the member the others are matched to; -1: the one of the first 8 matching the others best
+  bool sphere_orientation = true;  ///< settle left/right by sphere maps (genus-0 members; else by turns)
+  int sphere_effort = 0;         ///< effort of those maps (0..5; SphereParamOptions::effort)
+  int threads = 0;               ///< worker threads of those maps; 0 = hardware (results do not depend on it)
 };
 
 /// How one member was matched to the reference.
@@ -44,6 +56,9 @@ struct LandmarkMemberMatch {
   bool mirror_resolved = false;    ///< the intrinsically best assignment was the mirror image and orientation chose the other
   bool mirrored = false;           ///< the member appears to be a mirror image of the reference (orientation disagrees)
   bool mirror_ambiguous = false;   ///< orientation could not decide between two near-equal assignments
+  bool sphere_checked = false;     ///< the choice was made by sphere maps (else by turns of triples)
+  double sphere_agreement = 0;     ///< -1..1: signal correlation through the chosen assignment's map
+  double sphere_runner_up = -2;    ///< the same for the next best candidate (-2: none)
 };
 
 struct ProposeLandmarksResult {

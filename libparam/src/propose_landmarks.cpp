@@ -403,6 +403,9 @@ constexpr int kSphereCandidates = 8;
 // shared cats and FAUST bodies were the same for every weight from 0.2 to 0.5 (at 1 the
 // efficiency overrules the signal on FAUST, where a turned-round body costs little stretch).
 constexpr double kEfficiencyWeight = 0.35;
+// Weight of the mean pair error above the cheapest candidate's: 0.05 (the window's edge)
+// costs 0.15 of correlation.
+constexpr double kCostWeight = 3.0;
 // Agreements (correlations) closer than this do not decide.
 constexpr double kSphereMargin = 0.05;
 
@@ -545,13 +548,30 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     // out the other way round from where the member's own shape puts them (as the reference's
     // unconstrained map does for the reference). Both signals add: the correlation, and half
     // the log of the efficiency relative to the best candidate's.
+    // The efficiency term is bounded (a map at 60 % of the best candidate's efficiency is
+    // simply "worse"): with many features close together (a hand's five fingertips) the
+    // constrained maps' efficiencies scatter over orders of magnitude and would overrule
+    // everything else. The intrinsic cost keeps its say too: a candidate pays for how much
+    // its distances disagree beyond the cheapest's.
     const double best_eff = *std::max_element(effs.begin(), effs.end());
     for (std::size_t k = 0; k < scored.size(); ++k)
-      if (scored[k].first > -2) scored[k].first += kEfficiencyWeight * std::log(std::max(effs[k], 1e-12) / best_eff);
+      if (scored[k].first > -2)
+        scored[k].first += kEfficiencyWeight * std::max(std::log(std::max(effs[k], 1e-12) / best_eff), -0.5) -
+                           kCostWeight * (cands[scored[k].second].a.cost - cands.front().a.cost) / pairs;
     std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) {
       return x.first != y.first ? x.first > y.first : x.second < y.second;
     });
     if (scored.empty() || scored.front().first <= -2) continue;  // no map: the choice by turns stands
+    // Two candidates the signal cannot tell apart: flagged, not guessed; the choice by turns
+    // stands (a generated biped warped by a 1.5x anisotropic stretch: correlations 0.08 and
+    // 0.07, where the turns had it right).
+    if (scored.size() > 1 && scored.front().first - scored[1].first < kSphereMargin) {
+      ma.members[i].sphere_checked = true;
+      ma.members[i].sphere_agreement = scored.front().first;
+      ma.members[i].sphere_runner_up = scored[1].first;
+      ma.members[i].mirror_ambiguous = true;
+      continue;
+    }
     const Candidate& pick = cands[scored.front().second];
     LandmarkMemberMatch& mm = ma.members[i];
     ma.total += pick.a.cost / pairs - mm.cost;
@@ -567,8 +587,7 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     mm.mirrored = pick.a.cost - cheapest > kClose * pairs;
     mm.mirror_resolved = !mm.mirrored && scored.front().second != 0;
     mm.mirrored_cost = scored.size() > 1 ? cands[scored[1].second].a.cost / pairs : -1;
-    // Two candidates the signal cannot tell apart: flagged, not guessed.
-    mm.mirror_ambiguous = scored.size() > 1 && scored.front().first - scored[1].first < kSphereMargin;
+    mm.mirror_ambiguous = false;
     ma.to[i] = pick.a.to;
   }
   return true;

@@ -14,18 +14,8 @@ import os
 import sys
 import numpy as np
 
-
-def read_obj(path):
-    V, F = [], []
-    for line in open(path):
-        t = line.split()
-        if not t:
-            continue
-        if t[0] == 'v':
-            V.append([float(x) for x in t[1:4]])
-        elif t[0] == 'f':
-            F.append([int(x.split('/')[0]) - 1 for x in t[1:4]])
-    return np.array(V), np.array(F)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from eval_landmarks import read_obj  # noqa: E402  (the same OBJ reading as the evaluator)
 
 
 def main(argv):

@@ -13,12 +13,15 @@
 
 #include "detail/landmark_orientation.h"
 #include "spherekit/constrained_param.h"
+#include "spherekit/geometry_image.h"
 #include "spherekit/sphere_param.h"
 
 namespace spherekit {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// At most this many fine peaks per member (a hand's fingertips, a head's ears and nose, ...).
+constexpr int kMaxFinePeaks = 32;
 
 // Edge graph with Euclidean edge lengths (CSR), the surface's vertex normals and its area.
 struct MeshGraph {
@@ -128,12 +131,43 @@ struct Member {
   std::vector<int> ext;                        // extremity vertices, by decreasing AGD
   std::vector<std::vector<double>> dist;       // dist[i][v] from point i (extremities, then extras)
   std::vector<std::vector<int>> parent;
+  std::vector<int> fine;        // AGD maxima of the finer discs (fine_radius), by decreasing AGD
+  // Per extremity: another peak beyond its tip region (extremity_radius .. twice that) rises
+  // within tip_drop of its AGD. Which of the two is the disc's maximum then changes with the
+  // pose: a cat's head peaks at the nose on one member and at an ear tip on another (TOSCA cats,
+  // 0.11-0.16 sqrt(area) apart), and no tip centre can reconcile points that far apart.
+  std::vector<char> unstable;
 };
 
 void add_field(Member& m, int v) {
   m.dist.emplace_back();
   m.parent.emplace_back();
   dijkstra(m.g, v, m.dist.back(), &m.parent.back());
+}
+
+// Local maxima of the AGD, by decreasing AGD: 1-ring maxima kept when no vertex of their
+// geodesic disc of `radius` has a larger AGD and no kept one lies in it (one point per limb
+// tip, not one per bump); at most `max_count`.
+std::vector<int> agd_peaks(const Member& m, double radius, int max_count) {
+  const int n = static_cast<int>(m.agd.size());
+  std::vector<int> cand, out;
+  for (int v = 0; v < n; ++v) {
+    bool top = true;
+    for (int i = m.g.start[v]; i < m.g.start[v + 1] && top; ++i) top = m.agd[m.g.nbr[i]] <= m.agd[v];
+    if (top) cand.push_back(v);
+  }
+  std::sort(cand.begin(), cand.end(), [&](int a, int b) { return m.agd[a] != m.agd[b] ? m.agd[a] > m.agd[b] : a < b; });
+  std::vector<double> d;
+  for (int v : cand) {
+    if (static_cast<int>(out.size()) >= max_count) break;
+    dijkstra(m.g, v, d, nullptr, radius);
+    bool ok = true;
+    for (int u = 0; u < n && ok; ++u)
+      if (d[u] <= radius) ok = m.agd[u] <= m.agd[v];
+    for (int e : out) ok = ok && !(d[e] <= radius);
+    if (ok) out.push_back(v);
+  }
+  return out;
 }
 
 Status find_extremities(const TriMesh& mesh, int index, const ProposeLandmarksOptions& o, Member& m) {
@@ -155,25 +189,21 @@ Status find_extremities(const TriMesh& mesh, int index, const ProposeLandmarksOp
     }
     s = static_cast<int>(std::max_element(mind.begin(), mind.end()) - mind.begin());
   }
-  // Candidates: 1-ring maxima by decreasing AGD; kept when no vertex of the geodesic disc has
-  // a larger AGD and no kept extremity lies in it (one point per limb tip, not one per bump).
-  std::vector<int> cand;
-  for (int v = 0; v < n; ++v) {
-    bool top = true;
-    for (int i = m.g.start[v]; i < m.g.start[v + 1] && top; ++i) top = m.agd[m.g.nbr[i]] <= m.agd[v];
-    if (top) cand.push_back(v);
-  }
-  std::sort(cand.begin(), cand.end(), [&](int a, int b) { return m.agd[a] != m.agd[b] ? m.agd[a] > m.agd[b] : a < b; });
-  for (int v : cand) {
-    if (static_cast<int>(m.ext.size()) >= o.max_extremities) break;
-    dijkstra(m.g, v, d, nullptr, o.extremity_radius);
-    bool ok = true;
-    for (int u = 0; u < n && ok; ++u)
-      if (d[u] <= o.extremity_radius) ok = m.agd[u] <= m.agd[v];
-    for (int e : m.ext) ok = ok && !(d[e] <= o.extremity_radius);
-    if (ok) m.ext.push_back(v);
-  }
+  m.ext = agd_peaks(m, o.extremity_radius, o.max_extremities);
   for (int e : m.ext) add_field(m, e);
+  // Rival peaks (see `unstable`): every AGD maximum of a disc of fine_radius.
+  if (o.fine_radius > 0) {
+    m.fine = agd_peaks(m, o.fine_radius, kMaxFinePeaks);
+    m.unstable.assign(m.ext.size(), 0);
+    for (std::size_t j = 0; j < m.ext.size(); ++j)
+      for (int p : m.fine) {
+        if (std::find(m.ext.begin(), m.ext.end(), p) != m.ext.end()) continue;  // an extremity of its own
+        const double d = m.dist[j][p];
+        if (d > o.extremity_radius && d <= 2 * o.extremity_radius && m.agd[p] >= m.agd[m.ext[j]] - o.tip_drop) {
+          m.unstable[j] = 1;
+        }
+      }
+  }
   return Status::ok_status();
 }
 
@@ -183,14 +213,14 @@ Status find_extremities(const TriMesh& mesh, int index, const ProposeLandmarksOp
 // The region's centroid, each vertex weighted by its area and by how far its AGD rises above
 // the region's floor (so the centre moves smoothly as the AGD estimate's noise moves the
 // floor), and the region's vertex nearest to it.
-int tip_centre(const TriMesh& mesh, const Member& m, int f, double radius, double drop) {
-  const int e = m.ext[f];
+int tip_centre(const TriMesh& mesh, const Member& m, int e, const std::vector<double>& dist, double radius,
+               double drop) {
   const double floor = m.agd[e] - drop;
   std::vector<int> region;
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   double wsum = 0;
   for (int v = 0; v < static_cast<int>(m.agd.size()); ++v)
-    if (m.dist[f][v] < radius && m.agd[v] > floor) {
+    if (dist[v] < radius && m.agd[v] > floor) {
       const double w = m.g.varea[v] * (m.agd[v] - floor);
       c += w * mesh.V.row(v).transpose();
       wsum += w;
@@ -388,6 +418,12 @@ struct MatchAll {
   std::vector<std::vector<int>> to;  // per member: reference extremity -> member extremity (-1: none)
   std::vector<std::vector<Candidate>> cands;  // per member: the cheapest assignments, by cost
   double total = 0;                  // sum of the members' mean costs
+  // Per reference extremity: unstable (see unstable_extremities; empty when not looked for).
+  std::vector<char> unstable;
+  // Set by the sphere test: per member, the sphere map of its chosen assignment (the
+  // reference's own unconstrained map; empty where none was made), made with the stable
+  // extremities only where some are unstable.
+  std::vector<RowMat3d> maps;
 };
 
 // Two assignments are "about as good" when their mean pair error differs by less than this
@@ -496,6 +532,38 @@ MatchAll match_all(const std::vector<TriMesh>& meshes, const std::vector<Member>
   return ma;
 }
 
+// The reference extremities whose position is unstable (Member::unstable) on the reference or
+// on any member they are assigned to by a candidate within the sphere test's window: such a
+// point sits at a nose on one member and at an ear tip on another. They are neither proposed
+// nor pinned in the maps the finer peaks are carried through (one pinned at a nose on the
+// reference and at an ear tip on a member drags the whole head round). None are marked when
+// fewer than 3 stable ones would remain.
+void unstable_extremities(const std::vector<Member>& mem, int ref, MatchAll& ma) {
+  const int nm = static_cast<int>(mem.size());
+  const Member& rm = mem[ref];
+  const int kr = static_cast<int>(rm.ext.size());
+  const double pairs = kr * (kr + 1) / 2.0;
+  ma.unstable.assign(kr, 0);
+  if (rm.unstable.empty()) return;
+  for (int q = 0; q < kr; ++q) ma.unstable[q] = rm.unstable[q];
+  for (int i = 0; i < nm; ++i) {
+    if (i == ref || ma.cands[i].empty()) continue;
+    const double limit = ma.cands[i].front().a.cost + kSphereWindow * pairs;
+    for (const Candidate& c : ma.cands[i]) {
+      if (c.a.cost > limit) break;
+      for (int q = 0; q < kr; ++q)
+        if (c.a.to[q] >= 0 && mem[i].unstable[c.a.to[q]]) ma.unstable[q] = 1;
+    }
+  }
+  int stable = 0;
+  for (int q = 0; q < kr; ++q) {
+    bool everywhere = !ma.unstable[q];
+    for (int i = 0; i < nm; ++i) everywhere = everywhere && ma.to[i][q] >= 0;
+    stable += everywhere;
+  }
+  if (stable < 3) ma.unstable.assign(kr, 0);
+}
+
 // The sphere test (detail/landmark_orientation.h): the reference's unconstrained map places
 // its extremities; every assignment in a member's window becomes a constrained map of the
 // member with its matched extremities there, and the one whose correspondence carries the
@@ -516,6 +584,8 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
   if (!base.ok() || base->flipped_faces != 0) return true;
   const RowMat3d& S_ref = base->map.S;
   const std::vector<double> h_ref = detail::smoothed_normal_offset(meshes[ref], kSignalRadius);
+  ma.maps.assign(nm, RowMat3d());
+  ma.maps[ref] = S_ref;
   for (int i = 0; i < nm; ++i) {
     if (i == ref || ma.cands[i].empty()) continue;
     const std::vector<Candidate>& cands = ma.cands[i];
@@ -523,6 +593,7 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     const double limit = cands.front().a.cost + kSphereWindow * pairs;
     std::vector<std::pair<double, int>> scored;  // (agreement, candidate)
     std::vector<double> effs;
+    std::vector<RowMat3d> maps;
     for (int c = 0; c < static_cast<int>(cands.size()) && static_cast<int>(scored.size()) < kSphereCandidates; ++c) {
       if (cands[c].a.cost > limit) break;
       std::vector<int> fv;
@@ -539,6 +610,9 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
       if (map.ok() && map->flipped_faces == 0) {
         agree = detail::correspondence_agreement(meshes[ref], S_ref, h_ref, meshes[i], map->map.S, h);
         eff = map->efficiency;
+        maps.push_back(std::move(map->map.S));
+      } else {
+        maps.emplace_back();
       }
       scored.emplace_back(agree, c);
       effs.push_back(eff);
@@ -561,6 +635,11 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) {
       return x.first != y.first ? x.first > y.first : x.second < y.second;
     });
+    // The map of the assignment finally chosen (the turns' pick where the test cannot decide).
+    auto keep_map = [&] {
+      for (std::size_t k = 0; k < maps.size(); ++k)
+        if (cands[k].a.to == ma.to[i]) ma.maps[i] = std::move(maps[k]);
+    };
     if (scored.empty() || scored.front().first <= -2) continue;  // no map: the choice by turns stands
     // Two candidates the signal cannot tell apart: flagged, not guessed; the choice by turns
     // stands (a generated biped warped by a 1.5x anisotropic stretch: correlations 0.08 and
@@ -570,6 +649,7 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
       ma.members[i].sphere_agreement = scored.front().first;
       ma.members[i].sphere_runner_up = scored[1].first;
       ma.members[i].mirror_ambiguous = true;
+      keep_map();
       continue;
     }
     const Candidate& pick = cands[scored.front().second];
@@ -589,8 +669,86 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     mm.mirrored_cost = scored.size() > 1 ? cands[scored[1].second].a.cost / pairs : -1;
     mm.mirror_ambiguous = false;
     ma.to[i] = pick.a.to;
+    keep_map();
+  }
+  // Where extremities are unstable, the maps the fine stage carries points through are made
+  // again with only the stable ones pinned (the decision above keeps all pins: without the
+  // head, a cat's left/right is no longer seen by the signal).
+  if (std::find(ma.unstable.begin(), ma.unstable.end(), 1) == ma.unstable.end()) return true;
+  for (int i = 0; i < nm; ++i) {
+    if (i == ref || ma.maps[i].rows() == 0) continue;
+    std::vector<int> fv;
+    std::vector<Eigen::Vector3d> targets;
+    for (int q = 0; q < kr; ++q)
+      if (ma.to[i][q] >= 0 && !ma.unstable[q]) {
+        fv.push_back(mem[i].ext[ma.to[i][q]]);
+        targets.push_back(S_ref.row(rm.ext[q]).transpose());
+      }
+    ConstrainedParamOptions co;
+    co.sphere = so;
+    auto map = parameterize_sphere_constrained(meshes[i], fv, targets, co);
+    if (map.ok() && map->flipped_faces == 0)
+      ma.maps[i] = std::move(map->map.S);
+    else
+      ma.maps[i] = RowMat3d();
+    if (!report_progress(progress, "landmarks", i, 0.9)) return false;
   }
   return true;
+}
+
+// A vertex carried from one member to another through their sphere maps: the corner of the
+// face holding the same sphere point with the largest barycentric weight (-1: no face).
+struct Carrier {
+  const std::vector<TriMesh>& meshes;
+  const std::vector<RowMat3d>& maps;
+  const std::vector<SphereLocator>& locators;
+  int operator()(int from, int v, int to) const {
+    const SphereLocation l = locators[to].locate(maps[from].row(v).transpose().normalized());
+    if (l.face < 0) return -1;
+    int c = 0;
+    for (int k = 1; k < 3; ++k)
+      if (l.bary[k] > l.bary[c]) c = k;
+    return meshes[to].F(l.face, c);
+  }
+};
+
+// The finer AGD peaks matched through the sphere maps: a reference peak is carried to each
+// member and snapped to the member's nearest peak within fine_radius (peaks are at least that
+// far apart); kept when that holds on every member and each member's peak, carried back,
+// snaps to the same reference peak. Peaks inside a landmark's tip region (a hand's fingertips)
+// belong to that landmark and are not candidates. Returns per match the vertex on each member.
+std::vector<std::vector<int>> match_fine_peaks(const std::vector<Member>& mem, int ref, const ProposeLandmarksOptions& o,
+                                               const Carrier& carry, const std::vector<std::vector<int>>& anchors) {
+  const int nm = static_cast<int>(mem.size());
+  std::vector<std::vector<int>> cand(nm);
+  for (int i = 0; i < nm; ++i)
+    for (int p : mem[i].fine) {
+      bool free = true;
+      for (int f : anchors[i]) free = free && mem[i].dist[f][p] > o.extremity_radius;
+      if (free) cand[i].push_back(p);
+    }
+  std::vector<double> d;
+  auto snap = [&](int i, int v) {
+    if (v < 0) return -1;
+    dijkstra(mem[i].g, v, d, nullptr, o.fine_radius);
+    int best = -1;
+    for (int p : cand[i])
+      if (d[p] <= o.fine_radius && (best < 0 || d[p] < d[best])) best = p;
+    return best;
+  };
+  std::vector<std::vector<int>> out;
+  for (int p : cand[ref]) {
+    std::vector<int> at(nm, -1);
+    at[ref] = p;
+    bool ok = true;
+    for (int i = 0; i < nm && ok; ++i) {
+      if (i == ref) continue;
+      at[i] = snap(i, carry(ref, p, i));
+      ok = at[i] >= 0 && snap(ref, carry(i, at[i], ref)) == p;
+    }
+    if (ok) out.push_back(std::move(at));
+  }
+  return out;
 }
 
 }  // namespace
@@ -604,6 +762,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   if (o.max_extremities < 3 || o.max_extremities > 16) return R(ErrorCode::InvalidArgument, "max_extremities must be 3..16");
   if (!(o.extremity_radius > 0 && o.extremity_radius < 1)) return R(ErrorCode::InvalidArgument, "extremity_radius must be in (0, 1)");
   if (!(o.tip_drop >= 0 && o.tip_drop < 1)) return R(ErrorCode::InvalidArgument, "tip_drop must be in [0, 1)");
+  if (!(o.fine_radius >= 0 && o.fine_radius < 1)) return R(ErrorCode::InvalidArgument, "fine_radius must be in [0, 1)");
   if (o.extra_points < 0 || o.extra_points > 1000) return R(ErrorCode::InvalidArgument, "extra_points must be 0..1000");
   if (o.reference < -1 || o.reference >= nm) return R(ErrorCode::InvalidArgument, "reference out of range");
   if (o.sphere_effort < 0 || o.sphere_effort > 5) return R(ErrorCode::InvalidArgument, "sphere_effort must be 0..5");
@@ -633,6 +792,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     }
     if (ref < 0) return R(ErrorCode::InvalidInput, "no mesh has 3 extremities");
   }
+  if (o.fine_radius > 0) unstable_extremities(mem, ref, ma);
   if (o.sphere_orientation && !resolve_by_sphere(meshes, mem, ref, o, ma, progress))
     return R(ErrorCode::Cancelled, "cancelled");
   Member& rm = mem[ref];
@@ -643,12 +803,25 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   for (int i = 0; i < nm; ++i) out.extremities_found.push_back(static_cast<int>(mem[i].ext.size()));
   const std::vector<std::vector<int>>& to = ma.to;
 
-  // Names: the reference's extremities matched on every member, in decreasing AGD.
+  // Names: the reference's extremities matched on every member, in decreasing AGD, without
+  // the unstable ones (see unstable_extremities): where the maps allow, their region's finer
+  // peaks (a cat's ear tips) are matched through the maps instead.
+  const bool fine_stage = o.fine_radius > 0 && static_cast<int>(ma.maps.size()) == nm &&
+                          std::all_of(ma.maps.begin(), ma.maps.end(), [](const RowMat3d& S) { return S.rows() > 0; });
   std::vector<int> keep;
   for (int e = 0; e < kr; ++e) {
     bool all = true;
     for (int i = 0; i < nm; ++i) all = all && to[i][e] >= 0;
     if (all) keep.push_back(e);
+  }
+  if (!ma.unstable.empty()) {
+    std::vector<int> stable;
+    for (int e : keep)
+      if (!ma.unstable[e]) stable.push_back(e);
+    if (stable.size() >= 3) {
+      out.unstable_dropped = static_cast<int>(keep.size() - stable.size());
+      keep = std::move(stable);
+    }
   }
   if (keep.size() < 3) return R(ErrorCode::InvalidInput, "fewer than 3 extremities correspond across all members");
   // Each kept extremity moved to the centre of its tip region (see tip_centre), on every member
@@ -657,7 +830,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     for (int i = 0; i < nm; ++i)
       for (int e : keep) {
         const int f = to[i][e];
-        const int c = tip_centre(meshes[i], mem[i], f, o.extremity_radius, o.tip_drop);
+        const int c = tip_centre(meshes[i], mem[i], mem[i].ext[f], mem[i].dist[f], o.extremity_radius, o.tip_drop);
         if (c != mem[i].ext[f]) {
           mem[i].ext[f] = c;
           dijkstra(mem[i].g, c, mem[i].dist[f], &mem[i].parent[f]);
@@ -665,65 +838,93 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
       }
   out.landmarks.assign(nm, {});
   out.confidence.assign(nm, {});
-  // anchors[i]: per landmark, the index of its distance field in mem[i].dist.
-  std::vector<std::vector<int>> anchors(nm);
-  for (std::size_t q = 0; q < keep.size(); ++q) {
-    const std::string name = "lm" + std::to_string(q);
-    out.names.push_back(name);
-    for (int i = 0; i < nm; ++i) {
-      const int f = to[i][keep[q]];
-      anchors[i].push_back(f);
-      out.landmarks[i].push_back({name, mem[i].ext[f]});
+  // Per member and landmark: the index of its distance field in mem[i].dist, and its vertex.
+  std::vector<std::vector<int>> anchors(nm), at(nm);
+  auto add_landmark = [&](int i, int field, int vertex) {
+    if (static_cast<int>(out.names.size()) == static_cast<int>(out.landmarks[i].size()))
+      out.names.push_back("lm" + std::to_string(out.names.size()));
+    anchors[i].push_back(field);
+    at[i].push_back(vertex);
+    out.landmarks[i].push_back({out.names.back(), vertex});
+  };
+  for (int e : keep)
+    for (int i = 0; i < nm; ++i) add_landmark(i, to[i][e], mem[i].ext[to[i][e]]);
+
+  std::vector<SphereLocator> locators;
+  if (fine_stage) {
+    for (int i = 0; i < nm; ++i) locators.emplace_back(meshes[i].F, ma.maps[i]);
+    const Carrier carry{meshes, ma.maps, locators};
+    for (const std::vector<int>& peak : match_fine_peaks(mem, ref, o, carry, anchors)) {
+      for (int i = 0; i < nm; ++i) {
+        Member& m = mem[i];
+        add_field(m, peak[i]);
+        int v = peak[i];
+        if (o.tip_drop > 0) {
+          v = tip_centre(meshes[i], m, peak[i], m.dist.back(), o.fine_radius, o.tip_drop);
+          if (v != peak[i]) dijkstra(m.g, v, m.dist.back(), &m.parent.back());
+        }
+        add_landmark(i, static_cast<int>(m.dist.size()) - 1, v);
+      }
+      ++out.fine_matched;
     }
   }
-  out.extremities = static_cast<int>(keep.size());
+  out.extremities = static_cast<int>(out.names.size());
+
   // Confidence of an extremity's match: the mean |distance difference| to the other landmarks,
   // 1 at 0 and 1/2 at 0.02 sqrt(area) (the AGD maxima's own placement noise), halved when the
   // member's mirror is ambiguous.
-  auto conf = [](double err) { return 1.0 / (1.0 + (err / 0.02) * (err / 0.02)); };
+  auto conf = [&](int i, double err) {
+    return i == ref ? 1.0 : (1.0 / (1.0 + (err / 0.02) * (err / 0.02))) * (out.members[i].mirror_ambiguous ? 0.5 : 1.0);
+  };
+  const int ne = out.extremities;
   for (int i = 0; i < nm; ++i)
-    for (std::size_t q = 0; q < keep.size(); ++q) {
+    for (int q = 0; q < ne; ++q) {
       double err = 0;
-      for (std::size_t p = 0; p < keep.size(); ++p)
-        if (p != q) err += std::abs(rm.dist[anchors[ref][q]][rm.ext[keep[p]]] - mem[i].dist[anchors[i][q]][mem[i].ext[anchors[i][p]]]);
-      err /= static_cast<double>(keep.size() - 1);
-      out.confidence[i].push_back(i == ref ? 1.0 : conf(err) * (out.members[i].mirror_ambiguous ? 0.5 : 1.0));
+      for (int p = 0; p < ne; ++p)
+        if (p != q) err += std::abs(rm.dist[anchors[ref][q]][at[ref][p]] - mem[i].dist[anchors[i][q]][at[i][p]]);
+      out.confidence[i].push_back(conf(i, err / (ne - 1)));
     }
 
   // Further points: farthest-point sampling on the reference from the landmarks so far; on each
-  // member the vertex whose distances to the matched landmarks best fit the reference's
-  // (least squares), i.e. geodesic trilateration.
+  // member the point with the same sphere position under the maps (paper §4: the chosen
+  // assignment's constrained map), or where no maps were made, the vertex whose distances to
+  // the matched landmarks best fit the reference's (least squares), i.e. geodesic
+  // trilateration (which cannot tell a torso's front from its back).
   const int nr = static_cast<int>(meshes[ref].V.rows());
   std::vector<double> mind(nr, kInf);
   for (int f : anchors[ref])
     for (int v = 0; v < nr; ++v) mind[v] = std::min(mind[v], rm.dist[f][v]);
   for (int e = 0; e < o.extra_points; ++e) {
     const int pv = static_cast<int>(std::max_element(mind.begin(), mind.end()) - mind.begin());
-    const std::string name = "lm" + std::to_string(out.names.size());
-    out.names.push_back(name);
     std::vector<double> target;
     for (int f : anchors[ref]) target.push_back(rm.dist[f][pv]);
     for (int i = 0; i < nm; ++i) {
       Member& m = mem[i];
-      int best = pv;
-      double best_err = 0;
-      if (i != ref) {
-        best_err = kInf;
-        const int n = static_cast<int>(meshes[i].V.rows());
-        for (int v = 0; v < n; ++v) {
-          double s = 0;
-          for (std::size_t a = 0; a < target.size() && s < best_err; ++a) {
-            const double dd = m.dist[anchors[i][a]][v] - target[a];
-            s += dd * dd;
-          }
-          if (s < best_err) best_err = s, best = v;
+      auto fit = [&](int v, double bound) {
+        double s = 0;
+        for (std::size_t a = 0; a < target.size() && s < bound; ++a) {
+          const double dd = m.dist[anchors[i][a]][v] - target[a];
+          s += dd * dd;
         }
-        best_err = std::sqrt(best_err / target.size());
+        return s;
+      };
+      const int carried = i == ref || !fine_stage ? -1 : Carrier{meshes, ma.maps, locators}(ref, pv, i);
+      int best = pv;
+      if (i != ref) {
+        // Within 2 extremity radii of the carried point when there is one: the maps settle
+        // front from back, the distances place the point (the maps alone, with a handful of
+        // constraints, are off by 0.1-0.3 sqrt(area) far from them).
+        std::vector<double> near;
+        if (carried >= 0) dijkstra(m.g, carried, near, nullptr, 2 * o.extremity_radius);
+        double best_err = kInf;
+        const int n = static_cast<int>(meshes[i].V.rows());
+        for (int v = 0; v < n; ++v)
+          if (carried < 0 || near[v] <= 2 * o.extremity_radius)
+            if (const double s = fit(v, best_err); s < best_err) best_err = s, best = v;
       }
-      out.landmarks[i].push_back({name, best});
-      out.confidence[i].push_back(i == ref ? 1.0 : conf(best_err) * (out.members[i].mirror_ambiguous ? 0.5 : 1.0));
       add_field(m, best);
-      anchors[i].push_back(static_cast<int>(m.dist.size()) - 1);
+      add_landmark(i, static_cast<int>(m.dist.size()) - 1, best);
+      out.confidence[i].push_back(conf(i, std::sqrt(fit(best, kInf) / target.size())));
     }
     for (int v = 0; v < nr; ++v) mind[v] = std::min(mind[v], rm.dist.back()[v]);
     if (!report_progress(progress, "landmarks", e, 0.9 + 0.1 * (e + 1) / o.extra_points))

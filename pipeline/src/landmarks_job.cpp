@@ -56,10 +56,13 @@ Json to_json(const LandmarksJob& job, const LandmarksResult& r) {
   j["reference"] = job.meshes.at(static_cast<std::size_t>(p.reference));
   j["names"] = p.names;
   j["extremities"] = p.extremities;
+  j["unstable_dropped"] = p.unstable_dropped;
+  j["fine_matched"] = p.fine_matched;
   j["options"] = {{"agd_sources", job.options.agd_sources},
                   {"max_extremities", job.options.max_extremities},
                   {"extremity_radius", job.options.extremity_radius},
                   {"tip_drop", job.options.tip_drop},
+                  {"fine_radius", job.options.fine_radius},
                   {"extra_points", job.options.extra_points},
                   {"sphere_orientation", job.options.sphere_orientation},
                   {"sphere_effort", job.options.sphere_effort}};

@@ -33,6 +33,9 @@ int run_landmarks(const LandmarksArgs& a) {
   const auto& p = r->proposal;
   std::printf("%zu landmarks (%d extremities) on %zu meshes, %.2f s\n", p.names.size(), p.extremities,
               a.job.meshes.size(), r->seconds);
+  if (p.unstable_dropped > 0 || p.fine_matched > 0)
+    std::printf("  %d unstable extremities left out (another peak as high beyond the tip), %d finer peaks matched\n",
+                p.unstable_dropped, p.fine_matched);
   for (std::size_t i = 0; i < a.job.meshes.size(); ++i) {
     const auto& m = p.members[i];
     double low = 1;
@@ -56,8 +59,11 @@ void register_landmarks(CLI::App& app) {
       "settles left/right by sphere maps (each near-equal assignment becomes a constrained map;\n"
       "the one carrying the reference's shape best onto the member's wins: a left/right swap\n"
       "turns the body round; without sphere maps, or for meshes that are not genus 0, by the\n"
-      "turns of matched triples), optionally adds --extra-points further points (farthest-point sampling, located by\n"
-      "their distances to the matched ones), and writes one `NAME.lm.txt` per mesh (beside it, or\n"
+      "turns of matched triples), leaves out extremities whose peak is as high as another one beyond\n"
+      "the tip (a head peaking at the nose on one mesh and at an ear on another), adds the finer\n"
+      "peaks (--fine-radius) the sphere maps carry onto each other, optionally adds --extra-points\n"
+      "further points (farthest-point sampling, located by their distances to the matched ones near\n"
+      "where the sphere maps carry them), and writes one `NAME.lm.txt` per mesh (beside it, or\n"
       "in --output-dir), the format `consistent` reads. --report writes every match's confidence;\n"
       "members whose left/right cannot be told are flagged there and in the summary.",
       "  spherekit landmarks cats/*.obj --report landmarks.json\n"
@@ -75,6 +81,9 @@ void register_landmarks(CLI::App& app) {
       ->check(CLI::Range(0.001, 0.999));
   cmd->add_option("--tip-drop", o.tip_drop,
                   "move each extremity to the centre of its tip region: AGD within this of its peak (x sqrt(area); 0: the peak)")
+      ->check(CLI::Range(0.0, 0.999));
+  cmd->add_option("--fine-radius", o.fine_radius,
+                  "finer AGD peaks (this disc radius, x sqrt(area)) matched through the sphere maps; 0: off")
       ->check(CLI::Range(0.0, 0.999));
   cmd->add_flag("--no-sphere-orientation{false}", o.sphere_orientation,
                 "settle left/right by the turns of matched triples only, without sphere maps");

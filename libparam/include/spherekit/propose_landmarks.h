@@ -22,8 +22,18 @@
 //    Each matched extremity then moves to the centre of its tip region (the AGD within
 //    `tip_drop` of its maximum): a hand's nearly equal fingertip peaks trade places between
 //    poses, the centre of the hand's tip does not.
-// 4. Further points by farthest-point sampling on the reference, located on every member by
-//    their geodesic distances to the points already matched.
+// 4. Unstable extremities and finer peaks: an extremity with another peak beyond its tip
+//    region (up to twice `extremity_radius`) rising within `tip_drop` of it sits on different
+//    features on different members (a cat's head peaks at the nose on one and at an ear tip
+//    on another); it is left out, and the maps of the chosen assignments are made again with
+//    the stable ones. Then the AGD maxima of finer discs (`fine_radius`) outside every tip
+//    region are carried from the reference to each member through the sphere maps and
+//    snapped to the member's nearest such peak; those that snap on every member and snap
+//    back to themselves are added.
+// 5. Further points by farthest-point sampling on the reference, located on every member by
+//    their geodesic distances to the points already matched (near the point the sphere maps
+//    carry it to, when there are maps: the distances alone cannot tell a torso's front from
+//    its back).
 #pragma once
 
 #include <string>
@@ -41,6 +51,7 @@ struct ProposeLandmarksOptions {
   int max_extremities = 10;      ///< at most this many extremities per member (3..16)
   double extremity_radius = 0.15;  ///< an extremity dominates the AGD on this geodesic disc (x sqrt(area))
   double tip_drop = 0.03;        ///< a matched extremity moves to the centre of its tip region: AGD within this of its own (x sqrt(area)); 0: stays at the AGD maximum
+  double fine_radius = 0.08;     ///< finer AGD maxima (this disc radius, x sqrt(area)) matched through the sphere maps; 0: off
   int extra_points = 0;          ///< further points by farthest-point sampling (>= 0)
   int reference = -1;            ///< the member the others are matched to; -1: the one of the first 8 matching the others best
   bool sphere_orientation = true;  ///< settle left/right by sphere maps (genus-0 members; else by turns)
@@ -64,7 +75,9 @@ struct LandmarkMemberMatch {
 struct ProposeLandmarksResult {
   std::vector<std::string> names;               ///< lm0, lm1, ... (extremities first)
   int reference = 0;                            ///< the member the others were matched to
-  int extremities = 0;                          ///< how many of `names` are extremities
+  int extremities = 0;                          ///< how many of `names` are extremities (including finer peaks)
+  int unstable_dropped = 0;                     ///< extremities left out as unstable (another peak as high beyond the tip)
+  int fine_matched = 0;                         ///< finer AGD peaks matched through the sphere maps
   std::vector<std::vector<Landmark>> landmarks; ///< per member, in the order of `names`
   std::vector<std::vector<double>> confidence;  ///< per member and name, 0..1 (1 for the reference)
   std::vector<LandmarkMemberMatch> members;     ///< per member (the reference's is trivially 0 / 1)

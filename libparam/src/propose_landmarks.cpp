@@ -855,15 +855,24 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     for (int i = 0; i < nm; ++i) locators.emplace_back(meshes[i].F, ma.maps[i]);
     const Carrier carry{meshes, ma.maps, locators};
     for (const std::vector<int>& peak : match_fine_peaks(mem, ref, o, carry, anchors)) {
+      // Each moved to its (finer) tip region's centre; kept only where that is a vertex no
+      // landmark holds yet on any member (two features on one vertex cannot be mapped apart).
+      std::vector<int> v(nm);
+      bool free = true;
       for (int i = 0; i < nm; ++i) {
         Member& m = mem[i];
         add_field(m, peak[i]);
-        int v = peak[i];
-        if (o.tip_drop > 0) {
-          v = tip_centre(meshes[i], m, peak[i], m.dist.back(), o.fine_radius, o.tip_drop);
-          if (v != peak[i]) dijkstra(m.g, v, m.dist.back(), &m.parent.back());
-        }
-        add_landmark(i, static_cast<int>(m.dist.size()) - 1, v);
+        v[i] = o.tip_drop > 0 ? tip_centre(meshes[i], m, peak[i], m.dist.back(), o.fine_radius, o.tip_drop) : peak[i];
+        free = free && std::find(at[i].begin(), at[i].end(), v[i]) == at[i].end();
+      }
+      if (!free) {
+        for (int i = 0; i < nm; ++i) mem[i].dist.pop_back(), mem[i].parent.pop_back();
+        continue;
+      }
+      for (int i = 0; i < nm; ++i) {
+        Member& m = mem[i];
+        if (v[i] != peak[i]) dijkstra(m.g, v[i], m.dist.back(), &m.parent.back());
+        add_landmark(i, static_cast<int>(m.dist.size()) - 1, v[i]);
       }
       ++out.fine_matched;
     }

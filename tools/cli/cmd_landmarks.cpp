@@ -42,7 +42,7 @@ int run_landmarks(const LandmarksArgs& a) {
     for (double c : p.confidence[i]) low = std::min(low, c);
     std::printf("  %s -> %s: cost %.4f, lowest confidence %.2f%s%s%s\n", a.job.meshes[i].c_str(), r->files[i].c_str(),
                 m.cost, low, m.mirror_resolved ? ", left/right settled by orientation" : "",
-                m.mirrored ? ", appears MIRRORED" : "", m.mirror_ambiguous ? ", left/right AMBIGUOUS: check on the page" : "");
+                m.mirrored ? ", its cheapest match only reflected (a mirror image, or a pose of a near-symmetric shape: check)" : "", m.mirror_ambiguous ? ", left/right AMBIGUOUS: check on the page" : "");
   }
   return 0;
 }

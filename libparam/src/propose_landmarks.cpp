@@ -199,9 +199,8 @@ Status find_extremities(const TriMesh& mesh, int index, const ProposeLandmarksOp
       for (int p : m.fine) {
         if (std::find(m.ext.begin(), m.ext.end(), p) != m.ext.end()) continue;  // an extremity of its own
         const double d = m.dist[j][p];
-        if (d > o.extremity_radius && d <= 2 * o.extremity_radius && m.agd[p] >= m.agd[m.ext[j]] - o.tip_drop) {
+        if (d > o.extremity_radius && d <= 2 * o.extremity_radius && m.agd[p] >= m.agd[m.ext[j]] - o.tip_drop)
           m.unstable[j] = 1;
-        }
       }
   }
   return Status::ok_status();
@@ -584,6 +583,20 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
   if (!base.ok() || base->flipped_faces != 0) return true;
   const RowMat3d& S_ref = base->map.S;
   const std::vector<double> h_ref = detail::smoothed_normal_offset(meshes[ref], kSignalRadius);
+  // Member i's constrained map with its assigned extremities where the reference's map puts
+  // the reference's (without the unstable ones if asked).
+  auto pinned_map = [&](int i, const std::vector<int>& to, bool stable_only) {
+    std::vector<int> fv;
+    std::vector<Eigen::Vector3d> targets;
+    for (int q = 0; q < kr; ++q)
+      if (to[q] >= 0 && !(stable_only && ma.unstable[q])) {
+        fv.push_back(mem[i].ext[to[q]]);
+        targets.push_back(S_ref.row(rm.ext[q]).transpose());
+      }
+    ConstrainedParamOptions co;
+    co.sphere = so;
+    return parameterize_sphere_constrained(meshes[i], fv, targets, co);
+  };
   ma.maps.assign(nm, RowMat3d());
   ma.maps[ref] = S_ref;
   for (int i = 0; i < nm; ++i) {
@@ -596,16 +609,7 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     std::vector<RowMat3d> maps;
     for (int c = 0; c < static_cast<int>(cands.size()) && static_cast<int>(scored.size()) < kSphereCandidates; ++c) {
       if (cands[c].a.cost > limit) break;
-      std::vector<int> fv;
-      std::vector<Eigen::Vector3d> targets;
-      for (int q = 0; q < kr; ++q)
-        if (cands[c].a.to[q] >= 0) {
-          fv.push_back(mem[i].ext[cands[c].a.to[q]]);
-          targets.push_back(S_ref.row(rm.ext[q]).transpose());
-        }
-      ConstrainedParamOptions co;
-      co.sphere = so;
-      auto map = parameterize_sphere_constrained(meshes[i], fv, targets, co);
+      auto map = pinned_map(i, cands[c].a.to, false);
       double agree = -2, eff = 0;
       if (map.ok() && map->flipped_faces == 0) {
         agree = detail::correspondence_agreement(meshes[ref], S_ref, h_ref, meshes[i], map->map.S, h);
@@ -677,16 +681,7 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
   if (std::find(ma.unstable.begin(), ma.unstable.end(), 1) == ma.unstable.end()) return true;
   for (int i = 0; i < nm; ++i) {
     if (i == ref || ma.maps[i].rows() == 0) continue;
-    std::vector<int> fv;
-    std::vector<Eigen::Vector3d> targets;
-    for (int q = 0; q < kr; ++q)
-      if (ma.to[i][q] >= 0 && !ma.unstable[q]) {
-        fv.push_back(mem[i].ext[ma.to[i][q]]);
-        targets.push_back(S_ref.row(rm.ext[q]).transpose());
-      }
-    ConstrainedParamOptions co;
-    co.sphere = so;
-    auto map = parameterize_sphere_constrained(meshes[i], fv, targets, co);
+    auto map = pinned_map(i, ma.to[i], true);
     if (map.ok() && map->flipped_faces == 0)
       ma.maps[i] = std::move(map->map.S);
     else
@@ -851,9 +846,10 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     for (int i = 0; i < nm; ++i) add_landmark(i, to[i][e], mem[i].ext[to[i][e]]);
 
   std::vector<SphereLocator> locators;
-  if (fine_stage) {
+  if (fine_stage)
     for (int i = 0; i < nm; ++i) locators.emplace_back(meshes[i].F, ma.maps[i]);
-    const Carrier carry{meshes, ma.maps, locators};
+  const Carrier carry{meshes, ma.maps, locators};
+  if (fine_stage) {
     for (const std::vector<int>& peak : match_fine_peaks(mem, ref, o, carry, anchors)) {
       // Each moved to its (finer) tip region's centre; kept only where that is a vertex no
       // landmark holds yet on any member (two features on one vertex cannot be mapped apart).
@@ -917,7 +913,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
         }
         return s;
       };
-      const int carried = i == ref || !fine_stage ? -1 : Carrier{meshes, ma.maps, locators}(ref, pv, i);
+      const int carried = i == ref || !fine_stage ? -1 : carry(ref, pv, i);
       int best = pv;
       if (i != ref) {
         // Within 2 extremity radii of the carried point when there is one: the maps settle

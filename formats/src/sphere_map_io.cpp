@@ -83,10 +83,13 @@ Status parse_provenance(const std::string& path, std::string_view bytes, Provena
 
 }  // namespace
 
+Status check_sphere_map_path(const std::string& path) {
+  if (file_extension(path) != "obj") return Status(ErrorCode::Unsupported, path + ": sphere maps are written as .obj files");
+  return {};
+}
+
 Status write_sphere_map(const std::string& path, const TriMesh& mesh, const SphereMap& map) {
-  if (file_extension(path) != "obj") {
-    return Status(ErrorCode::Unsupported, path + ": sphere maps are written as .obj files");
-  }
+  SPHEREKIT_RETURN_IF_ERROR(check_sphere_map_path(path));
   if (map.S.rows() != mesh.V.rows()) {
     return Status(ErrorCode::InvalidInput, path + ": sphere map has " + std::to_string(map.S.rows()) +
                                                " points, mesh has " + std::to_string(mesh.V.rows()) + " vertices");

@@ -56,6 +56,7 @@ Result<ParamResult> map_mesh(const ParamJob& a, const ProgressFn& progress) {
   Stopwatch wall;
   // Every output folder must exist before any work: no partial set of outputs on failure.
   SPHEREKIT_RETURN_IF_ERROR(require_output_folders({a.output, a.dump_network}));
+  SPHEREKIT_RETURN_IF_ERROR(formats::check_sphere_map_path(a.output));
   ParamResult out;
   out.job = a;
   SPHEREKIT_ASSIGN_OR_RETURN(out.input, load_mesh_checked(a.mesh, /*allow_boundary=*/true, /*repair=*/false));

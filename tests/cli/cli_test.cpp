@@ -371,6 +371,21 @@ TEST_CASE("param checks every output folder before writing anything", "[cli]") {
   CHECK(files_in(out_dir).empty());
 }
 
+TEST_CASE("param refuses a sphere-map name it cannot write before reading the mesh", "[cli]") {
+  // The name is checked first: a mesh that does not exist is not even opened, so a user with a
+  // large mesh learns of a wrong -o name at once, not after the whole map was computed.
+  const std::string dir = spherekit::test::temp_dir("cli_param_output_name");
+  const std::string out_dir = dir + "/out";
+  fs::create_directories(out_dir);
+  CliRun p = run_cli("param " + quote(dir + "/absent.obj") + " -o " + quote(out_dir + "/absent.sph") + " --report " +
+                         quote(out_dir + "/r.json"),
+                     dir);
+  CHECK(p.exit_code != 0);
+  CHECK(p.err.find("absent.sph: sphere maps are written as .obj files") != std::string::npos);
+  CHECK(std::count(p.err.begin(), p.err.end(), '\n') == 1);
+  CHECK(files_in(out_dir).empty());
+}
+
 TEST_CASE("param on a mesh with holes maps the original vertices only; convert leaves the holes open", "[cli]") {
   const std::string dir = spherekit::test::temp_dir("cli_param_holes");
   const TriMesh holes = spherekit::test::sphere_with_holes(2, 2);

@@ -10,6 +10,10 @@
 
 namespace spherekit::formats {
 
+/// Whether `path` names a file write_sphere_map can write (an .obj), so a caller can refuse a
+/// wrong name before any work rather than after it.
+Status check_sphere_map_path(const std::string& path);
+
 /// Writes S with the faces of `mesh` atomically; a comment header records provenance.
 Status write_sphere_map(const std::string& path, const TriMesh& mesh, const SphereMap& map);
 

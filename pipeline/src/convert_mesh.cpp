@@ -19,6 +19,9 @@ namespace spherekit::pipeline {
 
 Result<ConvertMeshResult> convert_mesh(const ConvertMeshJob& job, const ProgressFn& progress) {
   SPHEREKIT_RETURN_IF_ERROR(check_convert_options(job.options));
+  // The image is OpenEXR whatever the name says; `-o out.png` wrote EXR data named .png.
+  if (formats::file_extension(job.output) != "exr")
+    return Status(ErrorCode::Unsupported, job.output + ": geometry images are written as .exr files");
   Stopwatch wall;
   ConvertMeshResult out;
   out.job = job;

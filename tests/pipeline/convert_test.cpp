@@ -99,6 +99,12 @@ TEST_CASE("convert_mesh: refused input writes nothing and names the file", "[pip
   CHECK(r.status().code() == ErrorCode::InvalidInput);
   CHECK(r.status().message().rfind(base + ".sphere.obj: not a bijective sphere map", 0) == 0);
   CHECK(test::files_in(dir + "/out").empty());
+  // An image name that is not .exr is refused before the mesh is even read (the image would be
+  // OpenEXR data under a .png name).
+  auto png = pipeline::convert_mesh({dir + "/absent.obj", dir + "/absent.sphere.obj", dir + "/out/x.png", "", small_options()});
+  REQUIRE_FALSE(png.ok());
+  CHECK(png.status().message() == dir + "/out/x.png: geometry images are written as .exr files");
+  CHECK(test::files_in(dir + "/out").empty());
   pipeline::ConvertOptions bad = small_options();
   bad.size = 20;
   CHECK(pipeline::check_convert_options(bad).message().find("--size 20") != std::string::npos);

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "detail/landmark_orientation.h"
+#include "detail/rim_landmarks.h"
 #include "spherekit/constrained_param.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/sphere_param.h"
@@ -22,6 +23,16 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // At most this many fine peaks per member (a hand's fingertips, a head's ears and nose, ...).
 constexpr int kMaxFinePeaks = 32;
+// Rim points judge the extremities (see the rim stage) when there are at least this many; an
+// extremity is an outlier beyond this multiple of the rim points' own disagreement, and never
+// below the floor: five times the AGD maxima's placement noise between poses (kClose), so on a
+// nearly isometric family, where the rim points agree almost exactly, ordinary noise is not
+// taken for a misplaced extremity.
+constexpr int kMinRimJudges = 4;
+// At most this many rounds of rim matching (each round may tell apart openings the previous
+// ones' points can judge).
+constexpr int kRimRounds = 4;
+constexpr double kRimOutlier = 2.0, kRimOutlierFloor = 0.05;
 
 // Edge graph with Euclidean edge lengths (CSR), the surface's vertex normals and its area.
 struct MeshGraph {
@@ -875,13 +886,79 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   }
   out.extremities = static_cast<int>(out.names.size());
 
+  // Rim points of corresponding openings (detail/rim_landmarks.h), told apart by their
+  // distances to the landmarks so far.
+  if (o.rim_points) {
+    // Rounds: an opening whose ends the extremities cannot tell apart (a coarse member's eye) may
+    // be told apart by the precise points of the openings matched before it (the mouth's).
+    std::vector<char> done;
+    for (int round = 0; round < kRimRounds; ++round) {
+      std::vector<detail::RimMember> rm_in(nm);
+      for (int i = 0; i < nm; ++i) {
+        rm_in[i].mesh = &meshes[i];
+        rm_in[i].sqrt_area = mem[i].g.sqrt_area;
+        for (int f : anchors[i]) rm_in[i].landmark_dist.push_back(&mem[i].dist[f]);
+      }
+      const std::vector<std::vector<int>> rim = detail::match_rim_points(rm_in, ref, done);
+      for (const std::vector<int>& pt : rim)
+        for (int i = 0; i < nm; ++i) {
+          add_field(mem[i], pt[i]);
+          add_landmark(i, static_cast<int>(mem[i].dist.size()) - 1, pt[i]);
+        }
+      out.rim_matched += static_cast<int>(rim.size());
+      if (rim.empty()) break;
+    }
+    // Rim points are placed to within a few edges (ICT heads: 0.000-0.005 sqrt(area)), the
+    // extremities of a flat distance field (a nose on a head) to within its tip region. So the
+    // rim points, once there are enough of them, judge the extremities: on each member, how far
+    // the rim points' distances to each other differ from the reference's is the family's own
+    // departure from isometry; an extremity whose distances to the rim points differ by more
+    // than kRimOutlier times that on some member is misplaced there, and is left out (ICT: the
+    // nose tip, 0.13 against the rim points' 0.044 on one head).
+    const int n_rim = out.rim_matched, n_ext = out.extremities;
+    if (n_rim >= kMinRimJudges) {
+      auto rel = [](double a, double b) { return std::abs(std::log((a + 0.02) / (b + 0.02))); };
+      auto d = [&](int i, int p, int q) { return mem[i].dist[anchors[i][p]][at[i][q]]; };
+      std::vector<char> drop(n_ext, 0);
+      for (int i = 0; i < nm; ++i) {
+        if (i == ref) continue;
+        double base = 0;
+        for (int p = n_ext; p < n_ext + n_rim; ++p)
+          for (int q = n_ext; q < n_ext + n_rim; ++q)
+            if (p != q) base += rel(d(ref, p, q), d(i, p, q));
+        base /= n_rim * (n_rim - 1);
+        for (int e = 0; e < n_ext; ++e) {
+          double dev = 0;
+          for (int q = n_ext; q < n_ext + n_rim; ++q) dev += rel(d(ref, e, q), d(i, e, q));
+          if (dev / n_rim > std::max(kRimOutlier * base, kRimOutlierFloor)) drop[e] = 1;
+        }
+      }
+      // Left out in every member's list alike; the names stay in order (lm0, lm1, ...).
+      int kept = 0;
+      for (int k = 0; k < n_ext + n_rim; ++k)
+        if (k >= n_ext || !drop[k]) {
+          for (int i = 0; i < nm; ++i) {
+            anchors[i][kept] = anchors[i][k];
+            at[i][kept] = at[i][k];
+            out.landmarks[i][kept] = {"lm" + std::to_string(kept), at[i][k]};
+          }
+          ++kept;
+        }
+      for (int i = 0; i < nm; ++i) anchors[i].resize(kept), at[i].resize(kept), out.landmarks[i].resize(kept);
+      out.names.resize(kept);
+      for (int k = 0; k < kept; ++k) out.names[k] = "lm" + std::to_string(k);
+      out.rim_outliers_dropped = n_ext + n_rim - kept;
+      out.extremities -= out.rim_outliers_dropped;
+    }
+  }
+
   // Confidence of an extremity's match: the mean |distance difference| to the other landmarks,
   // 1 at 0 and 1/2 at 0.02 sqrt(area) (the AGD maxima's own placement noise), halved when the
   // member's mirror is ambiguous.
   auto conf = [&](int i, double err) {
     return i == ref ? 1.0 : (1.0 / (1.0 + (err / 0.02) * (err / 0.02))) * (out.members[i].mirror_ambiguous ? 0.5 : 1.0);
   };
-  const int ne = out.extremities;
+  const int ne = static_cast<int>(out.names.size());
   for (int i = 0; i < nm; ++i)
     for (int q = 0; q < ne; ++q) {
       double err = 0;

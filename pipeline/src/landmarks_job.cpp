@@ -58,11 +58,14 @@ Json to_json(const LandmarksJob& job, const LandmarksResult& r) {
   j["extremities"] = p.extremities;
   j["unstable_dropped"] = p.unstable_dropped;
   j["fine_matched"] = p.fine_matched;
+  j["rim_matched"] = p.rim_matched;
+  j["rim_outliers_dropped"] = p.rim_outliers_dropped;
   j["options"] = {{"agd_sources", job.options.agd_sources},
                   {"max_extremities", job.options.max_extremities},
                   {"extremity_radius", job.options.extremity_radius},
                   {"tip_drop", job.options.tip_drop},
                   {"fine_radius", job.options.fine_radius},
+                  {"rim_points", job.options.rim_points},
                   {"extra_points", job.options.extra_points},
                   {"sphere_orientation", job.options.sphere_orientation},
                   {"sphere_effort", job.options.sphere_effort}};

@@ -28,6 +28,9 @@ TEST_CASE("landmarks: proposed files read back by check --landmarks, with a repo
   const auto j = read_json(dir + "/lm.json");
   REQUIRE(j["members"].size() == 2);
   const std::size_t names = j["names"].size();
+  // The samples are closed: no openings, so no rim points (the stage is on by default).
+  CHECK(j["rim_matched"].get<int>() == 0);
+  CHECK(j["options"]["rim_points"].get<bool>());
   CHECK(names == static_cast<std::size_t>(j["extremities"].get<int>()) + 2);
   for (const auto& m : j["members"]) {
     REQUIRE(m["landmarks"].size() == names);

@@ -36,6 +36,9 @@ int run_landmarks(const LandmarksArgs& a) {
   if (p.unstable_dropped > 0 || p.fine_matched > 0)
     std::printf("  %d unstable extremities left out (another peak as high beyond the tip), %d finer peaks matched\n",
                 p.unstable_dropped, p.fine_matched);
+  if (p.rim_matched > 0)
+    std::printf("  %d points on the rims of corresponding openings; %d extremities left out (their distances to them disagree)\n",
+                p.rim_matched, p.rim_outliers_dropped);
   for (std::size_t i = 0; i < a.job.meshes.size(); ++i) {
     const auto& m = p.members[i];
     double low = 1;
@@ -85,6 +88,8 @@ void register_landmarks(CLI::App& app) {
   cmd->add_option("--fine-radius", o.fine_radius,
                   "finer AGD peaks (this disc radius, x sqrt(area)) matched through the sphere maps; 0: off")
       ->check(CLI::Range(0.0, 0.999));
+  cmd->add_flag("--no-rim-points{false}", o.rim_points,
+                "no points on the rims of openings every mesh has (ends and side middles of eye and mouth holes)");
   cmd->add_flag("--no-sphere-orientation{false}", o.sphere_orientation,
                 "settle left/right by the turns of matched triples only, without sphere maps");
   cmd->add_option("--sphere-effort", o.sphere_effort, "effort of the sphere maps that settle left/right")->check(CLI::Range(0, 5));

@@ -30,7 +30,12 @@
 //    region are carried from the reference to each member through the sphere maps and
 //    snapped to the member's nearest such peak; those that snap on every member and snap
 //    back to themselves are added.
-// 5. Further points by farthest-point sampling on the reference, located on every member by
+// 5. Rim points: where the members have openings (boundary loops) that match by their
+//    distances to the landmarks so far, the ends of each elongated rim and the middles of its
+//    two sides (detail/rim_landmarks.h): a face's eye and mouth corners. Placed to within a
+//    few edges, they then judge the extremities: one whose distances to them disagree with the
+//    reference's far more than theirs do among themselves is left out.
+// 6. Further points by farthest-point sampling on the reference, located on every member by
 //    their geodesic distances to the points already matched (near the point the sphere maps
 //    carry it to, when there are maps: the distances alone cannot tell a torso's front from
 //    its back).
@@ -52,6 +57,7 @@ struct ProposeLandmarksOptions {
   double extremity_radius = 0.15;  ///< an extremity dominates the AGD on this geodesic disc (x sqrt(area))
   double tip_drop = 0.03;        ///< a matched extremity moves to the centre of its tip region: AGD within this of its own (x sqrt(area)); 0: stays at the AGD maximum
   double fine_radius = 0.08;     ///< finer AGD maxima (this disc radius, x sqrt(area)) matched through the sphere maps; 0: off
+  bool rim_points = true;        ///< add points on the rims of openings every member has (eye and mouth corners)
   int extra_points = 0;          ///< further points by farthest-point sampling (>= 0)
   int reference = -1;            ///< the member the others are matched to; -1: the one of the first 8 matching the others best
   bool sphere_orientation = true;  ///< settle left/right by sphere maps (genus-0 members; else by turns)
@@ -78,6 +84,8 @@ struct ProposeLandmarksResult {
   int extremities = 0;                          ///< how many of `names` are extremities (including finer peaks)
   int unstable_dropped = 0;                     ///< extremities left out as unstable (another peak as high beyond the tip)
   int fine_matched = 0;                         ///< finer AGD peaks matched through the sphere maps
+  int rim_matched = 0;                          ///< points on the rims of corresponding openings (after the extremities)
+  int rim_outliers_dropped = 0;                 ///< extremities left out: their distances to the rim points disagree (see the .cpp)
   std::vector<std::vector<Landmark>> landmarks; ///< per member, in the order of `names`
   std::vector<std::vector<double>> confidence;  ///< per member and name, 0..1 (1 for the reference)
   std::vector<LandmarkMemberMatch> members;     ///< per member (the reference's is trivially 0 / 1)

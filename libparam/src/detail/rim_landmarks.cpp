@@ -1,0 +1,218 @@
+// Rim points of corresponding openings (see rim_landmarks.h).
+#include "detail/rim_landmarks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "detail/check_topology.h"
+
+namespace spherekit::detail {
+namespace {
+
+// Relative differences are capped like the extremity match's pairs: beyond a factor 1.5 a
+// distance is simply "wrong".
+constexpr double kCap = 0.4;
+// Distances to a landmark on or next to the rim are offset by this (x sqrt(area)) before their
+// ratio is taken, so 0.001 against 0.002 does not count as a factor 2.
+constexpr double kNear = 0.02;
+// Openings with fewer rim vertices are scan noise, not features.
+constexpr int kMinRim = 6;
+// A side's middle is a point only where that side bulges by this share of the rim's length:
+// the two lips of a closed slit lie on top of each other.
+constexpr double kMinBulge = 0.1;
+// A point is kept only where the rim's extremum is sharp: the rim vertices within kFlat of the
+// extreme value (the other end's distance, or the side's distance from the chord) span at
+// most kMaxWindow (x sqrt(area)) of rim. An eye's or a mouth's corners and middles span
+// 0.004-0.021 on the ICT heads; a neck's cut, a wide gentle curve, 0.08-0.2: its "ends" move
+// with any change of shape.
+constexpr double kFlat = 0.02, kMaxWindow = 0.04;
+
+double rel(double a, double b) { return std::min(std::abs(std::log((a + kNear) / (b + kNear))), kCap); }
+
+struct Rim {
+  std::vector<int> v;          // rim vertices, the surface on the left
+  double perimeter = 0;        // x sqrt(area)
+  std::vector<double> to_lm;   // geodesic distance to each landmark
+  int i = 0, j = 0;            // positions of the two ends (i < j): the rim's diameter
+  int mid_ij = 0, mid_ji = 0;  // the farthest point from the chord on each side (positions)
+  double elongation = 0, bulge = 0;
+  bool sharp[4] = {};          // ends i, j, middles ij, ji: a sharp extremum (kMaxWindow)
+};
+
+Rim describe(const RimMember& m, std::vector<int> loop) {
+  const RowMat3d& V = m.mesh->V;
+  Rim r;
+  r.v = std::move(loop);
+  const int n = static_cast<int>(r.v.size());
+  for (int k = 0; k < n; ++k) r.perimeter += (V.row(r.v[k]) - V.row(r.v[(k + 1) % n])).norm() / m.sqrt_area;
+  for (const std::vector<double>* d : m.landmark_dist) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int v : r.v) best = std::min(best, (*d)[v]);
+    r.to_lm.push_back(best);
+  }
+  double diam = -1;
+  for (int a = 0; a < n; ++a)
+    for (int b = a + 1; b < n; ++b)
+      if (const double d = (V.row(r.v[a]) - V.row(r.v[b])).squaredNorm(); d > diam) diam = d, r.i = a, r.j = b;
+  diam = std::sqrt(diam);
+  const Eigen::Vector3d p = V.row(r.v[r.i]), u = (Eigen::Vector3d(V.row(r.v[r.j])) - p) / diam;
+  auto farthest = [&](int from, int to, int& at) {  // positions from .. to, going forward
+    double w = -1;
+    for (int k = from; k != to; k = (k + 1) % n) {
+      const Eigen::Vector3d x = Eigen::Vector3d(V.row(r.v[k])) - p;
+      if (const double d = (x - x.dot(u) * u).norm(); d > w) w = d, at = k;
+    }
+    return w;
+  };
+  const double wa = farthest(r.i, r.j, r.mid_ij), wb = farthest(r.j, r.i, r.mid_ji);
+  r.elongation = diam / std::max(wa + wb, 1e-300);
+  r.bulge = std::min(wa, wb) / diam;
+  // Rim length around each vertex (half of each adjacent segment), then the windows.
+  std::vector<double> len(n);
+  for (int k = 0; k < n; ++k)
+    len[k] = 0.5 * ((V.row(r.v[k]) - V.row(r.v[(k + 1) % n])).norm() + (V.row(r.v[k]) - V.row(r.v[(k + n - 1) % n])).norm()) /
+             m.sqrt_area;
+  auto window = [&](auto value, int from, int count) {  // `count` positions from `from`, forward
+    double top = 0, w = 0;
+    for (int c = 0; c < count; ++c) top = std::max(top, value((from + c) % n));
+    for (int c = 0; c < count; ++c)
+      if (value((from + c) % n) >= (1 - kFlat) * top) w += len[(from + c) % n];
+    return w;
+  };
+  auto from_end = [&](int e) { return [&, e](int k) { return (V.row(r.v[k]) - V.row(r.v[e])).norm(); }; };
+  auto off_chord = [&](int k) {
+    const Eigen::Vector3d x = Eigen::Vector3d(V.row(r.v[k])) - p;
+    return (x - x.dot(u) * u).norm();
+  };
+  r.sharp[0] = window(from_end(r.j), 0, n) <= kMaxWindow;
+  r.sharp[1] = window(from_end(r.i), 0, n) <= kMaxWindow;
+  r.sharp[2] = window(off_chord, r.i, r.j - r.i) <= kMaxWindow;
+  r.sharp[3] = window(off_chord, r.j, n - (r.j - r.i)) <= kMaxWindow;
+  return r;
+}
+
+std::vector<Rim> rims_of(const RimMember& m) {
+  const MeshTopology topo = build_topology(*m.mesh);
+  bool ok = false;
+  std::vector<Rim> rims;
+  for (const std::vector<int>& hl : trace_boundary_loops(*m.mesh, topo, &ok)) {
+    if (static_cast<int>(hl.size()) < kMinRim) continue;
+    std::vector<int> loop;
+    for (int h : hl) loop.push_back(he_from(*m.mesh, h));
+    rims.push_back(describe(m, std::move(loop)));
+  }
+  return ok ? rims : std::vector<Rim>{};
+}
+
+// Mean relative difference of two openings' distances to the landmarks and of their perimeters.
+double rim_cost(const Rim& a, const Rim& b) {
+  double s = std::min(std::abs(std::log(a.perimeter / b.perimeter)), kCap);
+  for (std::size_t l = 0; l < a.to_lm.size(); ++l) s += rel(a.to_lm[l], b.to_lm[l]);
+  return s / static_cast<double>(a.to_lm.size() + 1);
+}
+
+// The same for two rim vertices (their distances to every landmark).
+double point_cost(const RimMember& a, int va, const RimMember& b, int vb) {
+  double s = 0;
+  for (std::size_t l = 0; l < a.landmark_dist.size(); ++l) s += rel((*a.landmark_dist[l])[va], (*b.landmark_dist[l])[vb]);
+  return s / static_cast<double>(a.landmark_dist.size());
+}
+
+// The vertex next to rim vertex v that lies on no rim, nearest to it (v itself if none): a
+// feature on a rim makes the consistent method's final maps fail (ICT heads, 12 such features:
+// "a face stays flipped after removing the path network's Steiner vertices" in step 6 after 574
+// s; one ring in, step 6 completes in 13 s).
+int step_inside(const TriMesh& mesh, const std::vector<char>& on_rim, int v) {
+  int best = v;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      if (mesh.F(f, c) == v)
+        for (int k = 1; k < 3; ++k) {
+          const int u = mesh.F(f, (c + k) % 3);
+          const double d = (mesh.V.row(u) - mesh.V.row(v)).squaredNorm();
+          if (!on_rim[u] && (d < best_d || (d == best_d && u < best))) best_d = d, best = u;
+        }
+  return best;
+}
+
+}  // namespace
+
+std::vector<std::vector<int>> match_rim_points(const std::vector<RimMember>& members, int ref, std::vector<char>& done,
+                                               const RimOptions& o) {
+  const int nm = static_cast<int>(members.size());
+  std::vector<std::vector<int>> out;
+  if (nm < 1 || members[ref].landmark_dist.empty()) return out;
+  std::vector<std::vector<Rim>> rims(nm);
+  for (int i = 0; i < nm; ++i) {
+    rims[i] = rims_of(members[i]);
+    if (rims[i].empty()) return out;
+  }
+  std::vector<std::vector<char>> on_rim(nm);
+  for (int i = 0; i < nm; ++i) {
+    on_rim[i].assign(members[i].mesh->V.rows(), 0);
+    for (const Rim& r : rims[i])
+      for (int v : r.v) on_rim[i][v] = 1;
+  }
+  const std::vector<Rim>& rr = rims[ref];
+  done.resize(rr.size(), 0);
+  for (std::size_t a = 0; a < rr.size(); ++a) {
+    if (done[a] || rr[a].elongation < o.min_elongation) continue;
+    // Per member: the matched opening and whether its ends run the other way.
+    std::vector<int> match(nm, -1);
+    std::vector<char> swapped(nm, 0);
+    bool all = true;
+    for (int i = 0; i < nm && all; ++i) {
+      if (i == ref) {
+        match[i] = static_cast<int>(a);
+        continue;
+      }
+      const std::vector<Rim>& mr = rims[i];
+      int best = -1;
+      double c1 = std::numeric_limits<double>::infinity(), c2 = c1;
+      for (std::size_t b = 0; b < mr.size(); ++b) {
+        const double c = rim_cost(rr[a], mr[b]);
+        if (c < c1) c2 = c1, c1 = c, best = static_cast<int>(b);
+        else if (c < c2) c2 = c;
+      }
+      // Mutual: no other reference opening fits the member's better.
+      bool mutual = best >= 0;
+      for (std::size_t a2 = 0; a2 < rr.size() && mutual; ++a2)
+        mutual = a2 == a || rim_cost(rr[a2], mr[best]) > c1;
+      all = mutual && c1 <= o.max_cost && c1 <= o.margin * c2 && mr[best].elongation >= o.min_elongation;
+      if (!all) break;
+      match[i] = best;
+      const Rim& m = mr[best];
+      const RimMember &R = members[ref], &M = members[i];
+      const double same = point_cost(R, rr[a].v[rr[a].i], M, m.v[m.i]) + point_cost(R, rr[a].v[rr[a].j], M, m.v[m.j]);
+      const double swap = point_cost(R, rr[a].v[rr[a].i], M, m.v[m.j]) + point_cost(R, rr[a].v[rr[a].j], M, m.v[m.i]);
+      all = std::min(same, swap) <= o.margin * std::max(same, swap);
+      swapped[i] = swap < same;
+    }
+    if (!all) continue;
+    done[a] = 1;
+    // Ends, then the middles of the side from the first end to the second and of the other side
+    // (a swapped member's sides swap with its ends: the rim runs the same way round).
+    bool middles = true;
+    for (int i = 0; i < nm; ++i) middles = middles && rims[i][match[i]].bulge >= kMinBulge;
+    for (int k = 0; k < (middles ? 4 : 2); ++k) {
+      std::vector<int> pt(nm);
+      bool apart = true;
+      for (int i = 0; i < nm; ++i) {
+        const Rim& m = rims[i][match[i]];
+        const int pos[4] = {m.i, m.j, m.mid_ij, m.mid_ji};
+        const int pos_swapped[4] = {m.j, m.i, m.mid_ji, m.mid_ij};
+        const int sharp_of[4] = {0, 1, 2, 3}, sharp_swapped[4] = {1, 0, 3, 2};
+        apart = apart && m.sharp[swapped[i] ? sharp_swapped[k] : sharp_of[k]];
+        pt[i] = step_inside(*members[i].mesh, on_rim[i], m.v[swapped[i] ? pos_swapped[k] : pos[k]]);
+        for (const std::vector<double>* d : members[i].landmark_dist) apart = apart && (*d)[pt[i]] >= o.min_separation;
+        for (const std::vector<int>& q : out) apart = apart && q[i] != pt[i];
+      }
+      if (apart) out.push_back(std::move(pt));
+    }
+  }
+  return out;
+}
+
+}  // namespace spherekit::detail

@@ -1,0 +1,48 @@
+// Landmarks on the rims of corresponding openings (issue 25). A family of scans or models with
+// the same openings (a face's eyes and mouth, a body's open neck) has, on each opening's rim,
+// points as well defined as any extremity: the two ends of an elongated rim (the corners of an
+// eye or a mouth) and, on each side between them, the rim point farthest from the line
+// through the ends (the middle of a lid or a lip). Extremities (maxima of the average geodesic
+// distance) cannot see them: a rim is a feature of the boundary, not of the distance field.
+//
+// Matching without user input, given landmarks already matched on every member (the
+// extremities): an opening is described by its geodesic distances to those landmarks and its
+// perimeter, both relative to the surface's size; a reference opening and a member's are
+// matched when each is the other's best, clearly ahead of the runner-up (a left eye against a
+// right one differs in its distances to the ears). The two ends are told apart the same way,
+// and the sides between them follow from the rim's orientation (the surface on its left, the
+// same on every consistently oriented member). An opening that is round (no ends), ambiguous
+// or missing on some member gives no points: nothing is guessed.
+#pragma once
+
+#include <vector>
+
+#include "spherekit/mesh.h"
+
+namespace spherekit::detail {
+
+struct RimMember {
+  const TriMesh* mesh = nullptr;
+  double sqrt_area = 1;
+  // Geodesic distance fields (units of sqrt(area)) of the landmarks matched so far, in the same
+  // order on every member.
+  std::vector<const std::vector<double>*> landmark_dist;
+};
+
+struct RimOptions {
+  double min_elongation = 1.2;   // rim diameter / its width (sum of both sides' distances from the chord)
+  double min_separation = 0.05;  // a rim point this close (x sqrt(area)) to a landmark is left out
+  double max_cost = 0.25;        // mean relative distance difference of a matched opening
+  double margin = 0.7;           // the best match costs at most this share of the runner-up's
+};
+
+/// The matched rim points: per point, its vertex on every member (member order), the rim
+/// vertex's nearest neighbour off every rim (see step_inside in the .cpp). Openings are the
+/// meshes' boundary loops; meshes without any give nothing. `done` flags the reference's
+/// openings already matched (resized to their count; skipped, and set for those matched now):
+/// call again with the new points' distance fields among the landmarks, and an opening whose
+/// ends the extremities could not tell apart may be told apart by another's precise points.
+std::vector<std::vector<int>> match_rim_points(const std::vector<RimMember>& members, int ref, std::vector<char>& done,
+                                               const RimOptions& options = {});
+
+}  // namespace spherekit::detail

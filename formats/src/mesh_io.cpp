@@ -52,6 +52,12 @@ Result<TriMesh> parse_mesh(const std::string& path, std::string_view bytes, cons
 }  // namespace detail
 
 Result<TriMesh> read_mesh(const std::string& path, const ReadOptions& options, ReadInfo* info) {
+  // A folder given where meshes are expected (`spherekit run meshes/`) gets its own message,
+  // not "no file extension".
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    return Status(ErrorCode::IoError, path + ": is a directory, not a mesh file (name the meshes in it, e.g. " +
+                                          (std::filesystem::path(path) / "*.obj").string() + ")");
   // Check the extension first: no point reading a file we cannot parse.
   const std::string ext = file_extension(path);
   if (!is_readable_extension(ext)) return unsupported_extension(path, ext, kReadable);

@@ -178,6 +178,13 @@ TEST_CASE("writers honour a reduced precision and reject unknown extensions", "[
   CHECK_FALSE(fs::exists(dir + "/missing"));
 }
 
+TEST_CASE("a folder given as a mesh is named as a folder, with a hint", "[formats]") {
+  const std::string dir = test::temp_dir("formats_folder_as_mesh");
+  fs::create_directories(dir + "/meshes.obj");  // even with a mesh-like name
+  for (const std::string& p : {dir, dir + "/meshes.obj"})
+    check_error(read_mesh(p).status(), ErrorCode::IoError, p, "is a directory, not a mesh file (name the meshes in it");
+}
+
 TEST_CASE("file_extension is lower case without the dot", "[formats]") {
   CHECK(file_extension("a/b/Mesh.OBJ") == "obj");
   CHECK(file_extension("x.sphere.ply") == "ply");

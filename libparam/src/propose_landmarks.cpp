@@ -29,10 +29,10 @@ constexpr int kMaxFinePeaks = 32;
 // nearly isometric family, where the rim points agree almost exactly, ordinary noise is not
 // taken for a misplaced extremity.
 constexpr int kMinRimJudges = 4;
+constexpr double kRimOutlier = 2.0, kRimOutlierFloor = 0.05;
 // At most this many rounds of rim matching (each round may tell apart openings the previous
 // ones' points can judge).
 constexpr int kRimRounds = 4;
-constexpr double kRimOutlier = 2.0, kRimOutlierFloor = 0.05;
 
 // Edge graph with Euclidean edge lengths (CSR), the surface's vertex normals and its area.
 struct MeshGraph {
@@ -891,7 +891,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   if (o.rim_points) {
     // Rounds: an opening whose ends the extremities cannot tell apart (a coarse member's eye) may
     // be told apart by the precise points of the openings matched before it (the mouth's).
-    std::vector<char> done;
+    std::vector<char> done, crowded;  // crowded: per rim point (detail::RimPoint)
     for (int round = 0; round < kRimRounds; ++round) {
       std::vector<detail::RimMember> rm_in(nm);
       for (int i = 0; i < nm; ++i) {
@@ -899,13 +899,14 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
         rm_in[i].sqrt_area = mem[i].g.sqrt_area;
         for (int f : anchors[i]) rm_in[i].landmark_dist.push_back(&mem[i].dist[f]);
       }
-      const std::vector<std::vector<int>> rim = detail::match_rim_points(rm_in, ref, done);
-      for (const std::vector<int>& pt : rim)
+      const std::vector<detail::RimPoint> rim = detail::match_rim_points(rm_in, ref, done);
+      for (const detail::RimPoint& pt : rim) {
         for (int i = 0; i < nm; ++i) {
-          add_field(mem[i], pt[i]);
-          add_landmark(i, static_cast<int>(mem[i].dist.size()) - 1, pt[i]);
+          add_field(mem[i], pt.vertex[i]);
+          add_landmark(i, static_cast<int>(mem[i].dist.size()) - 1, pt.vertex[i]);
         }
-      out.rim_matched += static_cast<int>(rim.size());
+        crowded.push_back(pt.crowded);
+      }
       if (rim.empty()) break;
     }
     // Rim points are placed to within a few edges (ICT heads: 0.000-0.005 sqrt(area)), the
@@ -915,11 +916,12 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     // departure from isometry; an extremity whose distances to the rim points differ by more
     // than kRimOutlier times that on some member is misplaced there, and is left out (ICT: the
     // nose tip, 0.13 against the rim points' 0.044 on one head).
-    const int n_rim = out.rim_matched, n_ext = out.extremities;
+    // Every rim point judges, crowded ones too; only the others stay landmarks.
+    const int n_rim = static_cast<int>(crowded.size()), n_ext = out.extremities;
+    std::vector<char> drop(n_ext, 0);
     if (n_rim >= kMinRimJudges) {
       auto rel = [](double a, double b) { return std::abs(std::log((a + 0.02) / (b + 0.02))); };
       auto d = [&](int i, int p, int q) { return mem[i].dist[anchors[i][p]][at[i][q]]; };
-      std::vector<char> drop(n_ext, 0);
       for (int i = 0; i < nm; ++i) {
         if (i == ref) continue;
         double base = 0;
@@ -933,10 +935,12 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
           if (dev / n_rim > std::max(kRimOutlier * base, kRimOutlierFloor)) drop[e] = 1;
         }
       }
-      // Left out in every member's list alike; the names stay in order (lm0, lm1, ...).
+    }
+    // Left out in every member's list alike; the names stay in order (lm0, lm1, ...).
+    if (n_rim > 0) {
       int kept = 0;
       for (int k = 0; k < n_ext + n_rim; ++k)
-        if (k >= n_ext || !drop[k]) {
+        if (k < n_ext ? !drop[k] : !crowded[k - n_ext]) {
           for (int i = 0; i < nm; ++i) {
             anchors[i][kept] = anchors[i][k];
             at[i][kept] = at[i][k];
@@ -947,8 +951,9 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
       for (int i = 0; i < nm; ++i) anchors[i].resize(kept), at[i].resize(kept), out.landmarks[i].resize(kept);
       out.names.resize(kept);
       for (int k = 0; k < kept; ++k) out.names[k] = "lm" + std::to_string(k);
-      out.rim_outliers_dropped = n_ext + n_rim - kept;
+      out.rim_outliers_dropped = static_cast<int>(std::count(drop.begin(), drop.end(), 1));
       out.extremities -= out.rim_outliers_dropped;
+      out.rim_matched = kept - out.extremities;
     }
   }
 

@@ -197,7 +197,7 @@ TEST_CASE("propose_landmarks: the ends and sides of corresponding openings, told
   auto r = propose_landmarks(meshes, o);
   REQUIRE(r.ok());
   INFO("extremities " << r->extremities << ", rim points " << r->rim_matched << ", left out " << r->rim_outliers_dropped);
-  CHECK(r->rim_matched >= 8);  // the mouth's and the eyes' ends at least
+  CHECK(r->rim_matched >= 6);  // the three openings' ends at least (an eye's middles lie too close to its ends)
   CHECK(r->rim_outliers_dropped >= 1);
   REQUIRE(r->names.size() == static_cast<std::size_t>(r->extremities + r->rim_matched));
   const double sa = std::sqrt(mesh_area_for_test(meshes[0]));

@@ -31,18 +31,25 @@ struct RimMember {
 
 struct RimOptions {
   double min_elongation = 1.2;   // rim diameter / its width (sum of both sides' distances from the chord)
-  double min_separation = 0.05;  // a rim point this close (x sqrt(area)) to a landmark is left out
+  double min_separation = 0.05;  // a rim point this close (x sqrt(area)) to a landmark is left out, to an earlier rim point crowded
   double max_cost = 0.25;        // mean relative distance difference of a matched opening
   double margin = 0.7;           // the best match costs at most this share of the runner-up's
 };
 
-/// The matched rim points: per point, its vertex on every member (member order), the rim
-/// vertex's nearest neighbour off every rim (see step_inside in the .cpp). Openings are the
+struct RimPoint {
+  std::vector<int> vertex;  // per member (member order): the rim vertex's nearest neighbour off every rim
+  // Closer than min_separation to a point before it on some member (an eye's lid middles next to
+  // its corners): precise, so a judge of other matches, but too crowded to be a feature of the
+  // consistent method.
+  bool crowded = false;
+};
+
+/// The matched rim points (see step_inside in the .cpp for where they sit). Openings are the
 /// meshes' boundary loops; meshes without any give nothing. `done` flags the reference's
 /// openings already matched (resized to their count; skipped, and set for those matched now):
 /// call again with the new points' distance fields among the landmarks, and an opening whose
 /// ends the extremities could not tell apart may be told apart by another's precise points.
-std::vector<std::vector<int>> match_rim_points(const std::vector<RimMember>& members, int ref, std::vector<char>& done,
-                                               const RimOptions& options = {});
+std::vector<RimPoint> match_rim_points(const std::vector<RimMember>& members, int ref, std::vector<char>& done,
+                                       const RimOptions& options = {});
 
 }  // namespace spherekit::detail

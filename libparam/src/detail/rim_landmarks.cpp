@@ -16,9 +16,10 @@ constexpr double kCap = 0.4;
 // Distances to a landmark on or next to the rim are offset by this (x sqrt(area)) before their
 // ratio is taken, so 0.001 against 0.002 does not count as a factor 2.
 constexpr double kNear = 0.02;
-// Openings with fewer rim vertices are scan noise, not features.
-constexpr int kMinRim = 6;
-// A side's middle is a point only where that side bulges by this share of the rim's length:
+// Openings with fewer rim vertices are scan noise, not features; with more, a scan's outer
+// border, whose diameter (a search over all pairs) would cost more than the rest of the proposal.
+constexpr int kMinRim = 6, kMaxRim = 3000;
+// A side's middle is a point only where that side bulges by this share of the rim's diameter:
 // the two lips of a closed slit lie on top of each other.
 constexpr double kMinBulge = 0.1;
 // A point is kept only where the rim's extremum is sharp: the rim vertices within kFlat of the
@@ -97,7 +98,7 @@ std::vector<Rim> rims_of(const RimMember& m) {
   bool ok = false;
   std::vector<Rim> rims;
   for (const std::vector<int>& hl : trace_boundary_loops(*m.mesh, topo, &ok)) {
-    if (static_cast<int>(hl.size()) < kMinRim) continue;
+    if (static_cast<int>(hl.size()) < kMinRim || static_cast<int>(hl.size()) > kMaxRim) continue;
     std::vector<int> loop;
     for (int h : hl) loop.push_back(he_from(*m.mesh, h));
     rims.push_back(describe(m, std::move(loop)));

@@ -32,9 +32,10 @@
 //    back to themselves are added.
 // 5. Rim points: where the members have openings (boundary loops) that match by their
 //    distances to the landmarks so far, the ends of each elongated rim and the middles of its
-//    two sides (detail/rim_landmarks.h): a face's eye and mouth corners. Placed to within a
-//    few edges, they then judge the extremities: one whose distances to them disagree with the
-//    reference's far more than theirs do among themselves is left out.
+//    two sides (detail/rim_landmarks.h): a face's eye and mouth corners; a point crowding an
+//    earlier one (an eye's lid middles) only judges. Placed to within a few edges, they then
+//    judge the extremities: one whose distances to them disagree with the reference's far more
+//    than theirs do among themselves is left out.
 // 6. Further points by farthest-point sampling on the reference, located on every member by
 //    their geodesic distances to the points already matched (near the point the sphere maps
 //    carry it to, when there are maps: the distances alone cannot tell a torso's front from

@@ -891,15 +891,16 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   if (o.rim_points) {
     // Rounds: an opening whose ends the extremities cannot tell apart (a coarse member's eye) may
     // be told apart by the precise points of the openings matched before it (the mouth's).
-    std::vector<char> done, crowded;  // crowded: per rim point (detail::RimPoint)
+    std::vector<const TriMesh*> mesh_ptrs;
+    std::vector<double> sqrt_area;
+    for (int i = 0; i < nm; ++i) mesh_ptrs.push_back(&meshes[i]), sqrt_area.push_back(mem[i].g.sqrt_area);
+    detail::RimMatcher matcher(mesh_ptrs, sqrt_area);
+    std::vector<char> crowded;  // per rim point (detail::RimPoint)
     for (int round = 0; round < kRimRounds; ++round) {
-      std::vector<detail::RimMember> rm_in(nm);
-      for (int i = 0; i < nm; ++i) {
-        rm_in[i].mesh = &meshes[i];
-        rm_in[i].sqrt_area = mem[i].g.sqrt_area;
-        for (int f : anchors[i]) rm_in[i].landmark_dist.push_back(&mem[i].dist[f]);
-      }
-      const std::vector<detail::RimPoint> rim = detail::match_rim_points(rm_in, ref, done);
+      std::vector<std::vector<const std::vector<double>*>> fields(nm);
+      for (int i = 0; i < nm; ++i)
+        for (int f : anchors[i]) fields[i].push_back(&mem[i].dist[f]);
+      const std::vector<detail::RimPoint> rim = matcher.match(fields, ref);
       for (const detail::RimPoint& pt : rim) {
         for (int i = 0; i < nm; ++i) {
           add_field(mem[i], pt.vertex[i]);

@@ -31,27 +31,12 @@ constexpr double kFlat = 0.02, kMaxWindow = 0.04;
 
 double rel(double a, double b) { return std::min(std::abs(std::log((a + kNear) / (b + kNear))), kCap); }
 
-struct Rim {
-  std::vector<int> v;          // rim vertices, the surface on the left
-  double perimeter = 0;        // x sqrt(area)
-  std::vector<double> to_lm;   // geodesic distance to each landmark
-  int i = 0, j = 0;            // positions of the two ends (i < j): the rim's diameter
-  int mid_ij = 0, mid_ji = 0;  // the farthest point from the chord on each side (positions)
-  double elongation = 0, bulge = 0;
-  bool sharp[4] = {};          // ends i, j, middles ij, ji: a sharp extremum (kMaxWindow)
-};
-
-Rim describe(const RimMember& m, std::vector<int> loop) {
-  const RowMat3d& V = m.mesh->V;
+Rim describe(const TriMesh& mesh, double sqrt_area, std::vector<int> loop) {
+  const RowMat3d& V = mesh.V;
   Rim r;
   r.v = std::move(loop);
   const int n = static_cast<int>(r.v.size());
-  for (int k = 0; k < n; ++k) r.perimeter += (V.row(r.v[k]) - V.row(r.v[(k + 1) % n])).norm() / m.sqrt_area;
-  for (const std::vector<double>* d : m.landmark_dist) {
-    double best = std::numeric_limits<double>::infinity();
-    for (int v : r.v) best = std::min(best, (*d)[v]);
-    r.to_lm.push_back(best);
-  }
+  for (int k = 0; k < n; ++k) r.perimeter += (V.row(r.v[k]) - V.row(r.v[(k + 1) % n])).norm() / sqrt_area;
   double diam = -1;
   for (int a = 0; a < n; ++a)
     for (int b = a + 1; b < n; ++b)
@@ -73,7 +58,7 @@ Rim describe(const RimMember& m, std::vector<int> loop) {
   std::vector<double> len(n);
   for (int k = 0; k < n; ++k)
     len[k] = 0.5 * ((V.row(r.v[k]) - V.row(r.v[(k + 1) % n])).norm() + (V.row(r.v[k]) - V.row(r.v[(k + n - 1) % n])).norm()) /
-             m.sqrt_area;
+             sqrt_area;
   auto window = [&](auto value, int from, int count) {  // `count` positions from `from`, forward
     double top = 0, w = 0;
     for (int c = 0; c < count; ++c) top = std::max(top, value((from + c) % n));
@@ -93,31 +78,43 @@ Rim describe(const RimMember& m, std::vector<int> loop) {
   return r;
 }
 
-std::vector<Rim> rims_of(const RimMember& m) {
-  const MeshTopology topo = build_topology(*m.mesh);
+std::vector<Rim> rims_of(const TriMesh& mesh, double sqrt_area) {
+  const MeshTopology topo = build_topology(mesh);
   bool ok = false;
   std::vector<Rim> rims;
-  for (const std::vector<int>& hl : trace_boundary_loops(*m.mesh, topo, &ok)) {
+  for (const std::vector<int>& hl : trace_boundary_loops(mesh, topo, &ok)) {
     if (static_cast<int>(hl.size()) < kMinRim || static_cast<int>(hl.size()) > kMaxRim) continue;
     std::vector<int> loop;
-    for (int h : hl) loop.push_back(he_from(*m.mesh, h));
-    rims.push_back(describe(m, std::move(loop)));
+    for (int h : hl) loop.push_back(he_from(mesh, h));
+    rims.push_back(describe(mesh, sqrt_area, std::move(loop)));
   }
   return ok ? rims : std::vector<Rim>{};
 }
 
+// Per landmark: the geodesic distance from the rim (its nearest vertex).
+std::vector<double> rim_to_landmarks(const Rim& r, const std::vector<const std::vector<double>*>& landmark_dist) {
+  std::vector<double> out;
+  for (const std::vector<double>* d : landmark_dist) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int v : r.v) best = std::min(best, (*d)[v]);
+    out.push_back(best);
+  }
+  return out;
+}
+
 // Mean relative difference of two openings' distances to the landmarks and of their perimeters.
-double rim_cost(const Rim& a, const Rim& b) {
+double rim_cost(const Rim& a, const std::vector<double>& a_lm, const Rim& b, const std::vector<double>& b_lm) {
   double s = std::min(std::abs(std::log(a.perimeter / b.perimeter)), kCap);
-  for (std::size_t l = 0; l < a.to_lm.size(); ++l) s += rel(a.to_lm[l], b.to_lm[l]);
-  return s / static_cast<double>(a.to_lm.size() + 1);
+  for (std::size_t l = 0; l < a_lm.size(); ++l) s += rel(a_lm[l], b_lm[l]);
+  return s / static_cast<double>(a_lm.size() + 1);
 }
 
 // The same for two rim vertices (their distances to every landmark).
-double point_cost(const RimMember& a, int va, const RimMember& b, int vb) {
+double point_cost(const std::vector<const std::vector<double>*>& a, int va, const std::vector<const std::vector<double>*>& b,
+                  int vb) {
   double s = 0;
-  for (std::size_t l = 0; l < a.landmark_dist.size(); ++l) s += rel((*a.landmark_dist[l])[va], (*b.landmark_dist[l])[vb]);
-  return s / static_cast<double>(a.landmark_dist.size());
+  for (std::size_t l = 0; l < a.size(); ++l) s += rel((*a[l])[va], (*b[l])[vb]);
+  return s / static_cast<double>(a.size());
 }
 
 // The vertex next to rim vertex v that lies on no rim, nearest to it (v itself if none): a
@@ -140,26 +137,30 @@ int step_inside(const TriMesh& mesh, const std::vector<char>& on_rim, int v) {
 
 }  // namespace
 
-std::vector<RimPoint> match_rim_points(const std::vector<RimMember>& members, int ref, std::vector<char>& done,
-                                       const RimOptions& o) {
-  const int nm = static_cast<int>(members.size());
+RimMatcher::RimMatcher(const std::vector<const TriMesh*>& meshes, const std::vector<double>& sqrt_area, RimOptions options)
+    : meshes_(meshes), sqrt_area_(sqrt_area), o_(options) {
+  const int nm = static_cast<int>(meshes_.size());
+  for (int i = 0; i < nm; ++i) {
+    rims_.push_back(rims_of(*meshes_[i], sqrt_area_[i]));
+    on_rim_.emplace_back(meshes_[i]->V.rows(), 0);
+    for (const Rim& r : rims_.back())
+      for (int v : r.v) on_rim_.back()[v] = 1;
+  }
+}
+
+std::vector<RimPoint> RimMatcher::match(const std::vector<std::vector<const std::vector<double>*>>& landmark_dist, int ref) {
+  const int nm = static_cast<int>(meshes_.size());
   std::vector<RimPoint> out;
-  if (nm < 1 || members[ref].landmark_dist.empty()) return out;
-  std::vector<std::vector<Rim>> rims(nm);
-  for (int i = 0; i < nm; ++i) {
-    rims[i] = rims_of(members[i]);
-    if (rims[i].empty()) return out;
-  }
-  std::vector<std::vector<char>> on_rim(nm);
-  for (int i = 0; i < nm; ++i) {
-    on_rim[i].assign(members[i].mesh->V.rows(), 0);
-    for (const Rim& r : rims[i])
-      for (int v : r.v) on_rim[i][v] = 1;
-  }
-  const std::vector<Rim>& rr = rims[ref];
-  done.resize(rr.size(), 0);
+  if (nm < 1 || landmark_dist[ref].empty()) return out;
+  for (int i = 0; i < nm; ++i)
+    if (rims_[i].empty()) return out;
+  std::vector<std::vector<std::vector<double>>> to_lm(nm);  // per member and opening
+  for (int i = 0; i < nm; ++i)
+    for (const Rim& r : rims_[i]) to_lm[i].push_back(rim_to_landmarks(r, landmark_dist[i]));
+  const std::vector<Rim>& rr = rims_[ref];
+  done_.resize(rr.size(), 0);
   for (std::size_t a = 0; a < rr.size(); ++a) {
-    if (done[a] || rr[a].elongation < o.min_elongation) continue;
+    if (done_[a] || rr[a].elongation < o_.min_elongation) continue;
     // Per member: the matched opening and whether its ends run the other way.
     std::vector<int> match(nm, -1);
     std::vector<char> swapped(nm, 0);
@@ -169,55 +170,55 @@ std::vector<RimPoint> match_rim_points(const std::vector<RimMember>& members, in
         match[i] = static_cast<int>(a);
         continue;
       }
-      const std::vector<Rim>& mr = rims[i];
+      const std::vector<Rim>& mr = rims_[i];
       int best = -1;
       double c1 = std::numeric_limits<double>::infinity(), c2 = c1;
       for (std::size_t b = 0; b < mr.size(); ++b) {
-        const double c = rim_cost(rr[a], mr[b]);
+        const double c = rim_cost(rr[a], to_lm[ref][a], mr[b], to_lm[i][b]);
         if (c < c1) c2 = c1, c1 = c, best = static_cast<int>(b);
         else if (c < c2) c2 = c;
       }
       // Mutual: no other reference opening fits the member's better.
       bool mutual = best >= 0;
       for (std::size_t a2 = 0; a2 < rr.size() && mutual; ++a2)
-        mutual = a2 == a || rim_cost(rr[a2], mr[best]) > c1;
-      all = mutual && c1 <= o.max_cost && c1 <= o.margin * c2 && mr[best].elongation >= o.min_elongation;
+        mutual = a2 == a || rim_cost(rr[a2], to_lm[ref][a2], mr[best], to_lm[i][best]) > c1;
+      all = mutual && c1 <= o_.max_cost && c1 <= o_.margin * c2 && mr[best].elongation >= o_.min_elongation;
       if (!all) break;
       match[i] = best;
       const Rim& m = mr[best];
-      const RimMember &R = members[ref], &M = members[i];
+      const auto &R = landmark_dist[ref], &M = landmark_dist[i];
       const double same = point_cost(R, rr[a].v[rr[a].i], M, m.v[m.i]) + point_cost(R, rr[a].v[rr[a].j], M, m.v[m.j]);
       const double swap = point_cost(R, rr[a].v[rr[a].i], M, m.v[m.j]) + point_cost(R, rr[a].v[rr[a].j], M, m.v[m.i]);
-      all = std::min(same, swap) <= o.margin * std::max(same, swap);
+      all = std::min(same, swap) <= o_.margin * std::max(same, swap);
       swapped[i] = swap < same;
     }
     if (!all) continue;
-    done[a] = 1;
+    done_[a] = 1;
     // Ends, then the middles of the side from the first end to the second and of the other side
-    // (a swapped member's sides swap with its ends: the rim runs the same way round).
+    // (a swapped member's sides swap with its ends: the rim runs the same way round, so point k
+    // of the reference is the member's point k ^ 1).
     bool middles = true;
-    for (int i = 0; i < nm; ++i) middles = middles && rims[i][match[i]].bulge >= kMinBulge;
+    for (int i = 0; i < nm; ++i) middles = middles && rims_[i][match[i]].bulge >= kMinBulge;
     for (int k = 0; k < (middles ? 4 : 2); ++k) {
       RimPoint pt;
       pt.vertex.resize(nm);
       bool ok = true;
       for (int i = 0; i < nm; ++i) {
-        const Rim& m = rims[i][match[i]];
+        const Rim& m = rims_[i][match[i]];
+        const int at = swapped[i] ? k ^ 1 : k;
         const int pos[4] = {m.i, m.j, m.mid_ij, m.mid_ji};
-        const int pos_swapped[4] = {m.j, m.i, m.mid_ji, m.mid_ij};
-        const int sharp_of[4] = {0, 1, 2, 3}, sharp_swapped[4] = {1, 0, 3, 2};
-        ok = ok && m.sharp[swapped[i] ? sharp_swapped[k] : sharp_of[k]];
-        const int v = step_inside(*members[i].mesh, on_rim[i], m.v[swapped[i] ? pos_swapped[k] : pos[k]]);
+        ok = ok && m.sharp[at];
+        const int v = step_inside(*meshes_[i], on_rim_[i], m.v[pos[at]]);
         pt.vertex[i] = v;
-        for (const std::vector<double>* d : members[i].landmark_dist) ok = ok && (*d)[v] >= o.min_separation;
+        for (const std::vector<double>* d : landmark_dist[i]) ok = ok && (*d)[v] >= o_.min_separation;
         // Crowded: as close to a point taken before it (straight distance: the consistent
         // method fills the opening, so its paths may cross it). Four features around a small
         // eye, 0.03-0.04 sqrt(area) apart, made step 6 of a 3-head collection run for more than
         // 5 min (stopped); without the eyes' middles it took 3.3 s.
-        const RowMat3d& V = members[i].mesh->V;
+        const RowMat3d& V = meshes_[i]->V;
         for (const RimPoint& q : out) {
           ok = ok && q.vertex[i] != v;
-          if (!q.crowded && (V.row(q.vertex[i]) - V.row(v)).norm() < o.min_separation * members[i].sqrt_area) pt.crowded = true;
+          if (!q.crowded && (V.row(q.vertex[i]) - V.row(v)).norm() < o_.min_separation * sqrt_area_[i]) pt.crowded = true;
         }
       }
       if (ok) out.push_back(std::move(pt));

@@ -21,14 +21,6 @@
 
 namespace spherekit::detail {
 
-struct RimMember {
-  const TriMesh* mesh = nullptr;
-  double sqrt_area = 1;
-  // Geodesic distance fields (units of sqrt(area)) of the landmarks matched so far, in the same
-  // order on every member.
-  std::vector<const std::vector<double>*> landmark_dist;
-};
-
 struct RimOptions {
   double min_elongation = 1.2;   // rim diameter / its width (sum of both sides' distances from the chord)
   double min_separation = 0.05;  // a rim point this close (x sqrt(area)) to a landmark is left out, to an earlier rim point crowded
@@ -44,12 +36,36 @@ struct RimPoint {
   bool crowded = false;
 };
 
-/// The matched rim points (see step_inside in the .cpp for where they sit). Openings are the
-/// meshes' boundary loops; meshes without any give nothing. `done` flags the reference's
-/// openings already matched (resized to their count; skipped, and set for those matched now):
-/// call again with the new points' distance fields among the landmarks, and an opening whose
-/// ends the extremities could not tell apart may be told apart by another's precise points.
-std::vector<RimPoint> match_rim_points(const std::vector<RimMember>& members, int ref, std::vector<char>& done,
-                                       const RimOptions& options = {});
+// One opening's shape (its rim's vertices, ends, sides), which no landmark changes.
+struct Rim {
+  std::vector<int> v;          // rim vertices, the surface on the left
+  double perimeter = 0;        // x sqrt(area)
+  int i = 0, j = 0;            // positions of the two ends (i < j): the rim's diameter
+  int mid_ij = 0, mid_ji = 0;  // the farthest point from the chord on each side (positions)
+  double elongation = 0, bulge = 0;
+  bool sharp[4] = {};          // ends i, j, middles ij, ji: a sharp extremum
+};
+
+/// The members' openings, found once; matched in rounds as landmarks accumulate.
+class RimMatcher {
+ public:
+  /// Openings are the meshes' boundary loops; meshes without any give no points.
+  RimMatcher(const std::vector<const TriMesh*>& meshes, const std::vector<double>& sqrt_area, RimOptions options = {});
+
+  /// The points of the reference's openings not matched yet (see step_inside in the .cpp for
+  /// where they sit). landmark_dist[i]: member i's geodesic distance fields (units of
+  /// sqrt(area)) of the landmarks so far, in the same order on every member. Call again with
+  /// the new points' fields among them: an opening whose ends the extremities could not tell
+  /// apart may be told apart by another's precise points. `ref`: the same member in every call.
+  std::vector<RimPoint> match(const std::vector<std::vector<const std::vector<double>*>>& landmark_dist, int ref);
+
+ private:
+  std::vector<const TriMesh*> meshes_;
+  std::vector<double> sqrt_area_;
+  RimOptions o_;
+  std::vector<std::vector<Rim>> rims_;     // per member
+  std::vector<std::vector<char>> on_rim_;  // per member and vertex
+  std::vector<char> done_;                 // per reference opening: matched in an earlier round
+};
 
 }  // namespace spherekit::detail

@@ -454,6 +454,10 @@ constexpr double kEfficiencyWeight = 0.35;
 constexpr double kCostWeight = 3.0;
 // Agreements (correlations) closer than this do not decide.
 constexpr double kSphereMargin = 0.05;
+// A best raw correlation below this says the constrained maps do not carry the shape at all
+// (the 1.5x-stretched biped below: 0.08-0.2 for every candidate), so the test rules nothing
+// out; the signed signal agrees 0.3-0.9 where it works (cats, FAUST, ICT, warped quadrupeds).
+constexpr double kSphereInformative = 0.3;
 
 // Every member matched to the reference `ref` (which has at least 3 extremities).
 MatchAll match_all(const std::vector<TriMesh>& meshes, const std::vector<Member>& mem, int ref) {
@@ -643,6 +647,8 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
     // everything else. The intrinsic cost keeps its say too: a candidate pays for how much
     // its distances disagree beyond the cheapest's.
     const double best_eff = *std::max_element(effs.begin(), effs.end());
+    double raw_top = -2;
+    for (const auto& sc : scored) raw_top = std::max(raw_top, sc.first);
     for (std::size_t k = 0; k < scored.size(); ++k)
       if (scored[k].first > -2)
         scored[k].first += kEfficiencyWeight * std::max(std::log(std::max(effs[k], 1e-12) / best_eff), -0.5) -
@@ -656,14 +662,30 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
         if (cands[k].a.to == ma.to[i]) ma.maps[i] = std::move(maps[k]);
     };
     if (scored.empty() || scored.front().first <= -2) continue;  // no map: the choice by turns stands
-    // Two candidates the signal cannot tell apart: flagged, not guessed; the choice by turns
+    // Two candidates the signal cannot tell apart: flagged, not guessed. The choice by turns
     // stands (a generated biped warped by a 1.5x anisotropic stretch: correlations 0.08 and
-    // 0.07, where the turns had it right).
+    // 0.07, where the turns had it right) unless the test clearly ruled it out, and then the
+    // cheapest of the test's best few is kept (warped quadruped with holes: the turns' pick
+    // agreed 0.43, the best two 0.64 and 0.60; per detail::ambiguous_sphere_choice).
     if (scored.size() > 1 && scored.front().first - scored[1].first < kSphereMargin) {
-      ma.members[i].sphere_checked = true;
-      ma.members[i].sphere_agreement = scored.front().first;
-      ma.members[i].sphere_runner_up = scored[1].first;
-      ma.members[i].mirror_ambiguous = true;
+      LandmarkMemberMatch& mm = ma.members[i];
+      mm.sphere_checked = true;
+      mm.sphere_agreement = scored.front().first;
+      mm.sphere_runner_up = scored[1].first;
+      mm.mirror_ambiguous = true;
+      int turns_c = -1;
+      for (const auto& sc : scored)
+        if (cands[sc.second].a.to == ma.to[i]) turns_c = sc.second;
+      const int keep = detail::ambiguous_sphere_choice(scored, turns_c, raw_top, kSphereMargin, kSphereInformative);
+      if (keep >= 0 && keep != turns_c) {
+        const Candidate& pick = cands[keep];
+        ma.total += pick.a.cost / pairs - mm.cost;
+        mm.cost = pick.a.cost / pairs;
+        mm.orientation_agreement = pick.turn;
+        mm.mirrored = pick.a.cost - cands.front().a.cost > kClose * pairs;
+        mm.mirror_resolved = false;
+        ma.to[i] = pick.a.to;
+      }
       keep_map();
       continue;
     }

@@ -367,3 +367,22 @@ TEST_CASE("landmark orientation signal: sign, scale invariance, agreement throug
   turned.col(2) *= -1;  // a rotation by pi about y: the dent goes to -z
   CHECK(detail::correspondence_agreement(m, S, h, m, turned, h) < 0.5);
 }
+
+TEST_CASE("sphere test fallback: the turns' pick stands unless the test ruled it out", "[param]") {
+  using spherekit::detail::ambiguous_sphere_choice;
+  // (score, candidate), best first; candidate numbers rank the intrinsic cost.
+  const std::vector<std::pair<double, int>> scored{{0.64, 1}, {0.60, 2}, {0.43, 0}, {0.36, 4}};
+  // The turns chose candidate 0, which agrees far less than the best two: the cheapest of
+  // those two is kept.
+  CHECK(ambiguous_sphere_choice(scored, 0, 0.64, 0.05, 0.3) == 1);
+  // Within the margin of the best, the turns' pick stands even where it is not the cheapest.
+  CHECK(ambiguous_sphere_choice(scored, 2, 0.64, 0.05, 0.3) == 2);
+  // A weak signal (best raw correlation under the informative level) rules nothing out.
+  CHECK(ambiguous_sphere_choice(scored, 0, 0.2, 0.05, 0.3) == 0);
+  // The turns' pick was not scored at all: the cheapest of the best few.
+  const std::vector<std::pair<double, int>> later{{0.5, 3}, {0.47, 2}, {0.2, 1}};
+  CHECK(ambiguous_sphere_choice(later, -1, 0.5, 0.05, 0.3) == 2);
+  // Exactly `margin` below the best is outside.
+  const std::vector<std::pair<double, int>> edge{{0.5, 3}, {0.25, 1}};
+  CHECK(ambiguous_sphere_choice(edge, -1, 0.5, 0.25, 0.3) == 3);
+}

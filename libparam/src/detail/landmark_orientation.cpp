@@ -78,3 +78,20 @@ double correspondence_agreement(const TriMesh& ref, const RowMat3d& S_ref, const
 }
 
 }  // namespace spherekit::detail
+
+namespace spherekit::detail {
+
+int ambiguous_sphere_choice(const std::vector<std::pair<double, int>>& scored, int turns_pick, double raw_top,
+                            double margin, double informative) {
+  if (scored.empty() || raw_top < informative) return turns_pick;
+  const double top = scored.front().first;
+  int cheapest = -1;
+  for (const auto& [score, c] : scored) {
+    if (top - score >= margin) continue;
+    if (c == turns_pick) return turns_pick;
+    if (cheapest < 0 || c < cheapest) cheapest = c;
+  }
+  return cheapest;
+}
+
+}  // namespace spherekit::detail

@@ -12,6 +12,7 @@
 // heels), which no isometry-invariant signal sees but a signed, normal-relative one does.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "spherekit/mesh.h"
@@ -32,5 +33,20 @@ std::vector<double> smoothed_normal_offset(const TriMesh& mesh, double radius);
 /// maps are #V x 3 unit vectors. Returns -2 when the transfer fails.
 double correspondence_agreement(const TriMesh& ref, const RowMat3d& S_ref, const std::vector<double>& a,
                                 const TriMesh& member, const RowMat3d& S_member, const std::vector<double>& b);
+
+}  // namespace spherekit::detail
+
+namespace spherekit::detail {
+
+/// The sphere test's choice where its two best scores lie within `margin` of each other (the
+/// member is then flagged as ambiguous either way). `scored` holds (score, candidate) pairs,
+/// best first; candidates are numbered in order of intrinsic cost (0: cheapest). The
+/// candidate chosen by triple turns (`turns_pick`, -1 when it was not scored) stands when the
+/// test's signal is weak (its best raw correlation `raw_top` below `informative`) or when it
+/// scores within `margin` of the best. Otherwise the test has ruled the turns' pick out
+/// without deciding between its best few, and the cheapest of those within `margin` of the
+/// best is kept. Returns the candidate to keep.
+int ambiguous_sphere_choice(const std::vector<std::pair<double, int>>& scored, int turns_pick, double raw_top,
+                            double margin, double informative);
 
 }  // namespace spherekit::detail

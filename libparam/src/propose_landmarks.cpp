@@ -661,6 +661,18 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
       for (std::size_t k = 0; k < maps.size(); ++k)
         if (cands[k].a.to == ma.to[i]) ma.maps[i] = std::move(maps[k]);
     };
+    // The member takes candidate `pick` instead of the choice by turns.
+    auto adopt = [&](const Candidate& pick) {
+      LandmarkMemberMatch& mm = ma.members[i];
+      ma.total += pick.a.cost / pairs - mm.cost;
+      mm.cost = pick.a.cost / pairs;
+      mm.orientation_agreement = pick.turn;
+      // The cheapest assignment needs a turned-round body: if it is clearly cheaper than the
+      // pick, the member is a mirror image (intrinsically best only reflected); if not, the
+      // shape is (nearly) symmetric and its left/right was settled by the sphere test.
+      mm.mirrored = pick.a.cost - cands.front().a.cost > kClose * pairs;
+      ma.to[i] = pick.a.to;
+    };
     if (scored.empty() || scored.front().first <= -2) continue;  // no map: the choice by turns stands
     // Two candidates the signal cannot tell apart: flagged, not guessed. The choice by turns
     // stands (a generated biped warped by a 1.5x anisotropic stretch: correlations 0.08 and
@@ -678,34 +690,20 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
         if (cands[sc.second].a.to == ma.to[i]) turns_c = sc.second;
       const int keep = detail::ambiguous_sphere_choice(scored, turns_c, raw_top, kSphereMargin, kSphereInformative);
       if (keep >= 0 && keep != turns_c) {
-        const Candidate& pick = cands[keep];
-        ma.total += pick.a.cost / pairs - mm.cost;
-        mm.cost = pick.a.cost / pairs;
-        mm.orientation_agreement = pick.turn;
-        mm.mirrored = pick.a.cost - cands.front().a.cost > kClose * pairs;
+        adopt(cands[keep]);
         mm.mirror_resolved = false;
-        ma.to[i] = pick.a.to;
       }
       keep_map();
       continue;
     }
-    const Candidate& pick = cands[scored.front().second];
+    adopt(cands[scored.front().second]);
     LandmarkMemberMatch& mm = ma.members[i];
-    ma.total += pick.a.cost / pairs - mm.cost;
     mm.sphere_checked = true;
     mm.sphere_agreement = scored.front().first;
     mm.sphere_runner_up = scored.size() > 1 ? scored[1].first : -2;
-    mm.cost = pick.a.cost / pairs;
-    mm.orientation_agreement = pick.turn;
-    // The cheapest assignment needs a turned-round body: if it is clearly cheaper than the
-    // pick, the member is a mirror image (intrinsically best only reflected); if not, the
-    // shape is (nearly) symmetric and its left/right was settled here.
-    const double cheapest = cands.front().a.cost;
-    mm.mirrored = pick.a.cost - cheapest > kClose * pairs;
     mm.mirror_resolved = !mm.mirrored && scored.front().second != 0;
     mm.mirrored_cost = scored.size() > 1 ? cands[scored[1].second].a.cost / pairs : -1;
     mm.mirror_ambiguous = false;
-    ma.to[i] = pick.a.to;
     keep_map();
   }
   // Where extremities are unstable, the maps the fine stage carries points through are made

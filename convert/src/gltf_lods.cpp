@@ -151,8 +151,10 @@ Result<GltfLods> build_gltf_lods(const GeometryImage& image, const GltfLodOption
   return build_gltf_lods(levels, options, progress);
 }
 
-Result<GltfLods> build_original_gltf_lods(const TriMesh& mesh, const RowMat3d& S, int texture_size,
-                                          const GltfLodOptions& options, const ProgressFn& progress) {
+namespace {
+
+// The simplifier's options of original-mesh levels (single meshes and laid templates), checked.
+Result<OriginalLodOptions> original_options(const GltfLodOptions& options, int texture_size) {
   SPHEREKIT_RETURN_IF_ERROR(check_lod_options(texture_size, 1, options));
   if (!(options.texcoord_max_error_texels > 0))
     return Status(ErrorCode::InvalidArgument, "texture-coordinate error must be > 0 texels");
@@ -160,12 +162,48 @@ Result<GltfLods> build_original_gltf_lods(const TriMesh& mesh, const RowMat3d& S
   a.levels = options.levels;
   a.texture_size = texture_size;
   a.lod0_max_vertices = options.lod0_max_vertices;
+  return a;
+}
+
+}  // namespace
+
+Result<GltfLods> build_original_gltf_lods(const TriMesh& mesh, const RowMat3d& S, int texture_size,
+                                          const GltfLodOptions& options, const ProgressFn& progress) {
+  SPHEREKIT_ASSIGN_OR_RETURN(const OriginalLodOptions a, original_options(options, texture_size));
   SPHEREKIT_ASSIGN_OR_RETURN(std::vector<GltfMesh> meshes, original_lod_meshes(mesh, S, a, progress));
   GltfLodOptions o = options;
   o.mode = LodMode::Original;
   o.reference_rms_error = 0;  // level 0 is the mesh itself; each level's error is its distance to it
   return build_from_meshes(std::move(meshes), std::vector<int>(static_cast<std::size_t>(options.levels), texture_size),
                            texture_size, o, progress, &mesh);
+}
+
+Result<std::vector<GltfLods>> build_template_gltf_lods(const TemplateLayout& layout,
+                                                       const std::vector<TemplateLodMember>& members, int texture_size,
+                                                       const std::vector<GltfLodOptions>& options,
+                                                       const ProgressFn& progress) {
+  if (members.empty() || options.size() != members.size() ||
+      layout.positions.cols() != 3 * static_cast<Eigen::Index>(members.size()))
+    return Status(ErrorCode::InvalidArgument, "template levels of detail need one option set and layout per member");
+  for (const TemplateLodMember& m : members)
+    if (!m.mesh) return Status(ErrorCode::InvalidArgument, "template levels of detail: a member has no mesh");
+  const GltfLodOptions& first = options[0];
+  SPHEREKIT_ASSIGN_OR_RETURN(const OriginalLodOptions a, original_options(first, texture_size));
+  SPHEREKIT_ASSIGN_OR_RETURN(auto all, template_lod_meshes(layout, a, progress));
+  std::vector<GltfLods> out;
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    std::vector<GltfMesh> meshes;
+    for (auto& level : all) meshes.push_back(std::move(level[m]));
+    GltfLodOptions o = options[m];
+    o.mode = LodMode::Original;
+    o.levels = first.levels;
+    o.reference_rms_error = 0;  // each level's error is its distance to the member's own mesh
+    SPHEREKIT_ASSIGN_OR_RETURN(GltfLods lods,
+                               build_from_meshes(std::move(meshes), std::vector<int>(static_cast<std::size_t>(a.levels), texture_size),
+                                                 texture_size, o, progress, members[m].mesh));
+    out.push_back(std::move(lods));
+  }
+  return out;
 }
 
 Result<GltfLods> build_gltf_lods(const std::vector<GeometryImage>& level_images, const GltfLodOptions& options,

@@ -27,6 +27,7 @@ struct Cutter {
   std::vector<Eigen::Vector3d> V, S;
   std::vector<std::array<int, 3>> F;
   std::vector<std::uint8_t> hole;
+  std::vector<FoldCutMesh::EdgePoint> edge_points;  // per vertex made by a split
 
   // Splits every edge whose sphere chord strictly crosses the plane `axis` = 0 (and, if
   // on_plane >= 0, lies in the plane on_plane = 0), then re-triangulates the faces.
@@ -47,6 +48,7 @@ struct Cutter {
       s.normalize();
       V.push_back(V[p] + t * (V[q] - V[p]));
       S.push_back(s);
+      edge_points.push_back({p, q, t});
       const int id = static_cast<int>(V.size()) - 1;
       cut.emplace(key, id);
       return id;
@@ -181,26 +183,46 @@ Result<FoldCutMesh> cut_along_octahedral_fold(const TriMesh& mesh, const RowMat3
   for (std::size_t f = 0; f < c.F.size(); ++f)
     for (int k = 0; k < 3; ++k) out.mesh.F(static_cast<Eigen::Index>(f), k) = c.F[f][static_cast<std::size_t>(k)];
   out.hole_faces = std::move(c.hole);
+  out.edge_points = std::move(c.edge_points);
   return out;
 }
 
 Result<std::vector<GltfMesh>> original_lod_meshes(const TriMesh& mesh, const RowMat3d& S,
                                                   const OriginalLodOptions& options, const ProgressFn& progress) {
+  SPHEREKIT_RETURN_IF_ERROR(check_original_lod_options(options));
+  SPHEREKIT_ASSIGN_OR_RETURN(FoldCutMesh cut, cut_along_octahedral_fold(mesh, S));
+  SPHEREKIT_ASSIGN_OR_RETURN(auto levels, fold_cut_lod_meshes(cut, cut.mesh.V, options, progress));
+  std::vector<GltfMesh> out;
+  for (auto& level : levels) out.push_back(std::move(level[0]));
+  return out;
+}
+
+Status check_original_lod_options(const OriginalLodOptions& options) {
   if (options.levels < 1 || options.levels > 16)
     return Status(ErrorCode::InvalidArgument, "original-mesh levels of detail: levels must be in 1..16");
   if (!is_geometry_image_size(options.texture_size))
     return Status(ErrorCode::InvalidArgument, "original-mesh levels of detail: texture size must be 2^k+1");
   if (options.lod0_max_vertices < 0)
     return Status(ErrorCode::InvalidArgument, "original-mesh levels of detail: lod0 vertex cap must be >= 0");
-  SPHEREKIT_ASSIGN_OR_RETURN(FoldCutMesh cut, cut_along_octahedral_fold(mesh, S));
+  return Status();
+}
+
+Result<std::vector<std::vector<GltfMesh>>> fold_cut_lod_meshes(const FoldCutMesh& cut, const RowMatXd& P,
+                                                               const OriginalLodOptions& options,
+                                                               const ProgressFn& progress) {
+  SPHEREKIT_RETURN_IF_ERROR(check_original_lod_options(options));
   const auto nv = static_cast<int>(cut.mesh.V.rows());
   const RowMat3i& F = cut.mesh.F;
+  if (P.rows() != nv || P.cols() < 3 || P.cols() % 3 != 0 || !P.allFinite())
+    return Status(ErrorCode::InvalidArgument, "original-mesh levels of detail: positions must be finite, one row of 3n per vertex");
+  const auto nm = static_cast<int>(P.cols() / 3);
 
   ProgressiveMeshOptions pm_options;
   pm_options.constraint_edges = constraint_edges(cut);
   // Memoryless quadrics (the distances to the current level's planes) and a light edge-length
   // tie-break: the bunny's levels 1-3 are 3.6/3.9/2.0 dB better than with accumulated quadrics
   // and the remesh's tie-break 0.01, at the same vertex counts (eval-surface of the files).
+  // With several members the planes are 2-planes in R^3n (every member's distance at once).
   pm_options.memoryless = true;
   pm_options.edge_length_weight = 0.001;
   pm_options.degenerate_faces_free = true;  // the cut leaves slivers where it passes near a vertex
@@ -225,13 +247,13 @@ Result<std::vector<GltfMesh>> original_lod_meshes(const TriMesh& mesh, const Row
   for (int k = 0; k < options.levels; ++k)
     targets.push_back(std::min(nv, std::max(kept + 8, static_cast<int>(std::lround(lod0 / std::pow(4.0, k))))));
   pm_options.target_vertices = targets.back();
-  SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(cut.mesh.V, F, pm_options, progress));
+  SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, F, pm_options, progress));
 
   std::vector<std::vector<Eigen::Vector2d>> copies(static_cast<std::size_t>(nv));
   for (int v = 0; v < nv; ++v) copies[static_cast<std::size_t>(v)] = octahedral_copies(cut.S.row(v).transpose());
 
   CollapseReplay replay(pm);
-  std::vector<GltfMesh> out;
+  std::vector<std::vector<GltfMesh>> out;
   for (int k = 0; k < options.levels; ++k) {
     const std::size_t want = static_cast<std::size_t>(std::max(0, nv - targets[static_cast<std::size_t>(k)]));
     replay.advance_to(want);
@@ -259,43 +281,51 @@ Result<std::vector<GltfMesh>> original_lod_meshes(const TriMesh& mesh, const Row
       }
       faces.push_back({std::make_pair(v[0], best[0]), std::make_pair(v[1], best[1]), std::make_pair(v[2], best[2])});
     }
-    // Points = used (vertex, copy) pairs in ascending order.
+    // Points = used (vertex, copy) pairs in ascending order: the same for every member.
     std::map<std::pair<int, int>, int> point_of;
     for (const auto& t : faces)
       for (const auto& p : t) point_of.emplace(p, 0);
-    GltfMesh level;
+    GltfMesh shape;
     const auto np = static_cast<Eigen::Index>(point_of.size());
-    level.V.resize(np, 3);
-    level.UV.resize(np, 2);
-    level.N = RowMat3d::Zero(np, 3);
-    std::vector<int> vertex_rank(static_cast<std::size_t>(nv), -1);
+    shape.UV.resize(np, 2);
+    std::vector<int> vertex_rank(static_cast<std::size_t>(nv), -1), vertex_of;
     int vertices = 0;
     Eigen::Index p = 0;
     for (auto& [key, id] : point_of) {
       id = static_cast<int>(p);
-      level.V.row(p) = cut.mesh.V.row(key.first);
-      level.UV.row(p) =
+      vertex_of.push_back(key.first);
+      shape.UV.row(p) =
           octahedral_to_texcoord(copies[static_cast<std::size_t>(key.first)][static_cast<std::size_t>(key.second)],
                                  options.texture_size)
               .transpose();
       int& r = vertex_rank[static_cast<std::size_t>(key.first)];
       if (r < 0) r = vertices++;
-      level.position_index.push_back(r);
+      shape.position_index.push_back(r);
       ++p;
     }
-    level.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
-    std::vector<Eigen::Vector3d> vn(static_cast<std::size_t>(nv), Eigen::Vector3d::Zero());
-    for (std::size_t f = 0; f < faces.size(); ++f) {
-      for (int c = 0; c < 3; ++c) level.F(static_cast<Eigen::Index>(f), c) = point_of[faces[f][static_cast<std::size_t>(c)]];
-      const int a = faces[f][0].first, b = faces[f][1].first, c = faces[f][2].first;
-      const Eigen::Vector3d n = (cut.mesh.V.row(b) - cut.mesh.V.row(a)).transpose().cross(
-          (cut.mesh.V.row(c) - cut.mesh.V.row(a)).transpose());
-      for (int x : {a, b, c}) vn[static_cast<std::size_t>(x)] += n;
-    }
-    for (const auto& [key, id] : point_of) {
-      const Eigen::Vector3d n = vn[static_cast<std::size_t>(key.first)];
-      const double len = n.norm();
-      level.N.row(id) = (len > 0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d(0, 0, 1)).transpose();
+    shape.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+    for (std::size_t f = 0; f < faces.size(); ++f)
+      for (int c = 0; c < 3; ++c) shape.F(static_cast<Eigen::Index>(f), c) = point_of[faces[f][static_cast<std::size_t>(c)]];
+    std::vector<GltfMesh> level;
+    for (int m = 0; m < nm; ++m) {
+      GltfMesh mesh = shape;
+      mesh.V.resize(np, 3);
+      mesh.N = RowMat3d::Zero(np, 3);
+      auto pos = [&](int v) -> Eigen::Vector3d { return P.row(v).segment<3>(3 * m).transpose(); };
+      for (Eigen::Index q = 0; q < np; ++q) mesh.V.row(q) = pos(vertex_of[static_cast<std::size_t>(q)]).transpose();
+      // Area-weighted vertex normals of the member's level (shared by a vertex's copies).
+      std::vector<Eigen::Vector3d> vn(static_cast<std::size_t>(nv), Eigen::Vector3d::Zero());
+      for (const auto& t : faces) {
+        const int a = t[0].first, b = t[1].first, c = t[2].first;
+        const Eigen::Vector3d n = (pos(b) - pos(a)).cross(pos(c) - pos(a));
+        for (int x : {a, b, c}) vn[static_cast<std::size_t>(x)] += n;
+      }
+      for (Eigen::Index q = 0; q < np; ++q) {
+        const Eigen::Vector3d n = vn[static_cast<std::size_t>(vertex_of[static_cast<std::size_t>(q)])];
+        const double len = n.norm();
+        mesh.N.row(q) = (len > 0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d(0, 0, 1)).transpose();
+      }
+      level.push_back(std::move(mesh));
     }
     out.push_back(std::move(level));
   }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "spherekit/convert/gltf_mesh.h"
 #include "spherekit/convert/gltf_morph.h"
@@ -21,6 +22,82 @@ namespace fs = std::filesystem;
 
 namespace spherekit::pipeline {
 namespace {
+
+// A laid template that folds over on more than this share of its faces on some member is not
+// even tried (see template_or_remesh_levels): a folded face is a hole and a fin in that
+// member's levels.
+constexpr double kMaxTemplateFolds = 0.05;
+// Points sampled per direction for that choice when the PSNRs themselves are not asked for.
+constexpr int kChoiceSamples = 20000;
+
+// The worst member's level-0 PSNR of `lods` (each decoded level 0 against the member's mesh).
+double worst_level0_psnr(const std::vector<formats::LoadedMember>& members, const std::vector<convert::GltfLods>& lods,
+                         const RemeshErrorOptions& psnr) {
+  double worst = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const auto& d = lods[k].levels[0].primitive.decoded.mesh;
+    worst = std::min(worst, remesh_error(members[k].mesh, TriMesh{d.V, d.F}, psnr).psnr);
+  }
+  return worst;
+}
+
+// A collection's levels under LodMode::Original: the template member's mesh laid on every
+// member (template_lods.h), or the common remesh's levels (adaptive_lods.h), whichever has the
+// better worst member at level 0 (decoded, against the members' meshes). The laid template is
+// exact on the template, but where the consistent maps do not agree at its triangle scale its
+// triangles fold over on a member (TOSCA cat0 on cat2: 2.4% of its faces, level 0 at 51.8 dB
+// against the remesh's 68.0 dB); the remesh's levels keep the faces spanning the members'
+// openings (ICT heads: 31-36 dB at level 0, laid 55-101 dB). A template folding on more than
+// kMaxTemplateFolds of its faces is not tried. result: lod_connectivity and its record.
+Result<std::vector<convert::GltfLods>> template_or_remesh_levels(const std::vector<formats::LoadedMember>& members,
+                                                                  int lod_template, const std::vector<GeometryImage>& images,
+                                                                  std::vector<convert::GltfLodOptions> lod_options,
+                                                                  const ConvertOptions& o, const ProgressFn& progress,
+                                                                  ConvertCollectionResult& result) {
+  std::vector<convert::TemplateLodMember> tm;
+  for (const formats::LoadedMember& m : members) tm.push_back({&m.mesh, &m.map.S});
+  SPHEREKIT_ASSIGN_OR_RETURN(convert::TemplateLayout layout, convert::lay_template(tm, lod_template));
+  Json folds = Json::object();
+  double worst_fold = 0;
+  std::string worst_name;
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const double share = layout.faces > 0 ? static_cast<double>(layout.folded_faces[k]) / layout.faces : 0.0;
+    folds[members[k].name] = {{"folded_faces", layout.folded_faces[k]}, {"share", share},
+                              {"vertices_over_holes", layout.outside_vertices[k]}};
+    if (share > worst_fold) worst_fold = share, worst_name = members[k].name;
+  }
+  result.lod_template_folds = std::move(folds);
+  result.lod_template = members[static_cast<std::size_t>(lod_template)].name;
+  std::vector<convert::GltfLodOptions> remesh_options = lod_options;
+  for (convert::GltfLodOptions& lo : remesh_options) lo.mode = convert::LodMode::Adaptive;
+  SPHEREKIT_ASSIGN_OR_RETURN(std::vector<convert::GltfLods> remesh,
+                             convert::build_consistent_gltf_lods(images, remesh_options, progress));
+  char why[256];
+  if (worst_fold > kMaxTemplateFolds) {
+    std::snprintf(why, sizeof why, "the template %s laid on %s folds over on %.1f%% of its faces", result.lod_template.c_str(),
+                  worst_name.c_str(), 100 * worst_fold);
+    result.lod_connectivity = "remesh";
+    result.lod_connectivity_reason = why;
+    return remesh;
+  }
+  for (convert::GltfLodOptions& lo : lod_options) lo.lod0_max_vertices = 0;  // the template's count
+  SPHEREKIT_ASSIGN_OR_RETURN(std::vector<convert::GltfLods> laid,
+                             convert::build_template_gltf_lods(layout, tm, o.size, lod_options, progress));
+  RemeshErrorOptions psnr;
+  psnr.samples = std::max(o.psnr_samples, kChoiceSamples);
+  psnr.threads = o.threads;
+  const double laid_psnr = worst_level0_psnr(members, laid, psnr), remesh_psnr = worst_level0_psnr(members, remesh, psnr);
+  result.lod_choice = {{"template_worst_level0_psnr_db", laid_psnr}, {"remesh_worst_level0_psnr_db", remesh_psnr}};
+  if (laid_psnr >= remesh_psnr) {
+    result.lod_connectivity = "template";
+    return laid;
+  }
+  std::snprintf(why, sizeof why, "the template %s laid on every member has a worst level 0 of %.1f dB, the remesh %.1f dB",
+                result.lod_template.c_str(), laid_psnr, remesh_psnr);
+  result.lod_connectivity = "remesh";
+  result.lod_connectivity_reason = why;
+  return remesh;
+}
 
 // The texel (row, column) of an n x n octahedral image nearest to sphere point p.
 std::pair<int, int> nearest_texel(const Eigen::Vector3d& p, int n) {
@@ -122,6 +199,12 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
       return Status(ErrorCode::InvalidInput, job.collection + ": map of " + m.name + " has " + std::to_string(flipped) +
                                                  " flipped or degenerate faces on the sphere");
 
+  // The levels' template (LodMode::Original): the collection's reference member, whose map
+  // the others' were made consistent with (else the first member).
+  int lod_template = 0;
+  for (std::size_t k = 0; k < members.size(); ++k)
+    if (info.manifest.reference && members[k].name == *info.manifest.reference) lod_template = static_cast<int>(k);
+
   ConvertCollectionResult result;
   result.job = job;
   Json& report = result.report;
@@ -148,14 +231,16 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
           out.seconds = t.seconds();
           result.members.push_back(std::move(out));
         }
-        // Adaptive levels: one simplification of every member in R^3n (adaptive_lods.h), so level
-        // k has one connectivity in every member and each level is also a morph-target glTF.
-        if (o.lods > 0 && o.lod_mode != convert::LodMode::Uniform) {  // Original: adaptive for members
+        // One simplification of every member in R^3n, so level k has one connectivity in every
+        // member and each level is also a morph-target glTF: Original simplifies the template
+        // member's own mesh carried onto every member (template_lods.h), Adaptive the common
+        // geometry-image remesh (adaptive_lods.h).
+        if (o.lods > 0 && o.lod_mode != convert::LodMode::Uniform) {
           std::vector<GeometryImage> images;
           std::vector<convert::GltfLodOptions> lod_options;
           for (const ConvertedMember& c : result.members) {
             convert::GltfLodOptions lo;
-            lo.mode = convert::LodMode::Adaptive;
+            lo.mode = o.lod_mode;
             lo.levels = o.lods;
             lo.budget = o.budget;
             lo.reference_rms_error = c.assets.measured ? c.assets.error.rms : 0;
@@ -167,8 +252,14 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
             images.push_back(c.assets.image);
             lod_options.push_back(std::move(lo));
           }
-          SPHEREKIT_ASSIGN_OR_RETURN(std::vector<convert::GltfLods> lods,
-                                     convert::build_consistent_gltf_lods(images, lod_options, progress));
+          std::vector<convert::GltfLods> lods;
+          result.lod_connectivity = o.lod_mode == convert::LodMode::Adaptive ? "remesh" : "template";
+          if (o.lod_mode == convert::LodMode::Original) {
+            SPHEREKIT_ASSIGN_OR_RETURN(lods, template_or_remesh_levels(members, lod_template, images, lod_options, o,
+                                                                        progress, result));
+          } else {
+            SPHEREKIT_ASSIGN_OR_RETURN(lods, convert::build_consistent_gltf_lods(images, lod_options, progress));
+          }
           RemeshErrorOptions psnr;
           psnr.samples = o.psnr_samples;
           psnr.threads = o.threads;
@@ -223,6 +314,13 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
         if (o.cage > 0)
           report["cage"] = {{"n", o.cage}, {"tile", o.cage_tile}, {"displacement", displacement_kind_name(o.displacement)}};
         report["lods"] = o.lods;
+        if (o.lods > 0) {
+          Json c = {{"kind", o.lod_mode == convert::LodMode::Uniform ? "uniform" : result.lod_connectivity}};
+          if (!result.lod_template.empty()) c["template"] = result.lod_template, c["template_folds"] = result.lod_template_folds;
+          if (!result.lod_connectivity_reason.empty()) c["reason"] = result.lod_connectivity_reason;
+          if (!result.lod_choice.is_null()) c["choice"] = result.lod_choice;
+          report["lod_connectivity"] = std::move(c);
+        }
         report["version"] = kVersion;
         report["times"]["wall"] = wall.seconds();
         return formats::write_file_atomic((fs::path(dir) / kConvertReport).string(), report.dump(2) + "\n");

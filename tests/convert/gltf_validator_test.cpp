@@ -102,6 +102,27 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     auto open = build_original_gltf_lods(holed.mesh, holed.S, 33, original);
     REQUIRE(open.ok());
     write("original_holed_lods.glb", open->combined_glb);
+    // A collection's levels on its template member's mesh (template_lods_test): two blobs of
+    // different connectivity, each level's files and its morph-target file.
+    const TriMesh other = test::random_blob(4, 8);
+    const RowMat3d blob_S = blob.V.rowwise().normalized(), other_S = other.V.rowwise().normalized();
+    const std::vector<TemplateLodMember> members{{&blob, &blob_S}, {&other, &other_S}};
+    auto layout = lay_template(members, 1);
+    REQUIRE(layout.ok());
+    auto laid = build_template_gltf_lods(*layout, members, 65, {original, original});
+    REQUIRE(laid.ok());
+    for (std::size_t m = 0; m < 2; ++m) {
+      auto laid_paths = write_gltf_lods(dir + "/template_member" + std::to_string(m), (*laid)[m]);
+      REQUIRE(laid_paths.ok());
+      files.insert(files.end(), laid_paths->levels.begin(), laid_paths->levels.end());
+      files.push_back(laid_paths->combined);
+    }
+    for (std::size_t k = 0; k < (*laid)[0].levels.size(); ++k) {
+      auto morph =
+          build_gltf_morph_targets(std::vector<GltfMesh>{(*laid)[0].levels[k].mesh, (*laid)[1].levels[k].mesh});
+      REQUIRE(morph.ok());
+      write("template_morph_plain_lod" + std::to_string(k) + ".glb", morph->glb);
+    }
   }
 
   // gltf_morph_test: uncompressed, Draco sequential, from triangle meshes.

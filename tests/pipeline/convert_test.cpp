@@ -2,6 +2,8 @@
 // program: one mesh with its sphere map, the refusals that leave nothing written, and a
 // collection converted into one folder whose members share one layout.
 #include <catch2/catch.hpp>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "spherekit/formats/atomic_file.h"
@@ -157,5 +159,101 @@ TEST_CASE("convert_collection: every member into one folder with one layout and 
     auto again = pipeline::convert_collection({col, dir + "/assets", small_options()}, {}, [] { return false; });
     CHECK(again.status().code() == ErrorCode::Cancelled);
     CHECK(test::files_in(dir + "/assets") == names);
+  }
+}
+
+namespace {
+
+// A collection folder of the given members (mesh + map), reference `reference`.
+std::string write_collection(const std::string& dir, const std::vector<MappedMesh>& members, const std::string& reference) {
+  const std::string col = dir + "/col";
+  fs::create_directories(col);
+  formats::CollectionManifest m;
+  m.reference = reference;
+  m.features.push_back({"north", Eigen::Vector3d(0, 0, 1), std::nullopt});
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const std::string name = "m" + std::to_string(k);
+    REQUIRE(formats::write_mesh(dir + "/" + name + ".obj", members[k].mesh).ok());
+    REQUIRE(formats::write_sphere_map(col + "/" + name + ".sphere.obj", members[k].mesh, members[k].map).ok());
+    formats::CollectionMember e;
+    e.name = name;
+    e.map = name + ".sphere.obj";
+    e.source = dir + "/" + name + ".obj";
+    e.vertices = members[k].mesh.V.rows();
+    m.members.push_back(e);
+  }
+  REQUIRE(formats::write_file_atomic(col + "/features.txt", formats::sphere_points_text({"north"}, m.locations())).ok());
+  REQUIRE(formats::write_file_atomic(col + "/collection.json", formats::collection_manifest_text(m)).ok());
+  return col;
+}
+
+}  // namespace
+
+TEST_CASE("convert_collection: levels on the reference member's own mesh, or the remesh where it folds", "[pipeline]") {
+  const std::string dir = test::temp_dir("pipeline_convert_template_levels");
+  pipeline::ConvertOptions o = small_options();
+  o.cage = 0;
+  o.lods = 3;
+  MappedMesh a{test::random_blob(2, 21), {}}, b{test::random_blob(3, 22), {}};
+  a.map.S = a.mesh.V.rowwise().normalized();
+  b.map.S = b.mesh.V.rowwise().normalized();
+
+  SECTION("the reference's mesh fits every member: its levels") {
+    const std::string col = write_collection(dir, {a, b}, "m1");
+    auto r = pipeline::convert_collection({col, dir + "/assets", o});
+    REQUIRE(r.ok());
+    CHECK(r->lod_connectivity == "template");
+    CHECK(r->lod_template == "m1");
+    CHECK(r->lod_connectivity_reason.empty());
+    CHECK(r->report["lod_connectivity"]["kind"] == "template");
+    CHECK(r->report["lod_connectivity"]["template_folds"]["m0"]["folded_faces"] == 0);
+    const pipeline::Json& choice = r->report["lod_connectivity"]["choice"];
+    CHECK(choice["template_worst_level0_psnr_db"].get<double>() >= choice["remesh_worst_level0_psnr_db"].get<double>());
+    // Level 0 has the reference's vertex count (m1: a finer blob than m0) on both members, and
+    // every level one connectivity.
+    const auto& l0 = r->members[0].assets.lods.levels;
+    const auto& l1 = r->members[1].assets.lods.levels;
+    REQUIRE(l0.size() == 3);
+    for (std::size_t k = 0; k < 3; ++k) CHECK(l0[k].mesh.F == l1[k].mesh.F);
+    CHECK(*std::max_element(l0[0].mesh.position_index.begin(), l0[0].mesh.position_index.end()) + 1 == b.mesh.V.rows());
+    const auto names = test::files_in(dir + "/assets");
+    CHECK(std::count(names.begin(), names.end(), "collection_morph_lod2.glb") == 1);
+  }
+  // m1's map turns the cap round the north pole by half a turn (and, if `both`, the south
+  // pole's cap too), each latitude circle rigidly: still one-to-one on m1's fine mesh, but the
+  // coarse m0 laid on it folds over.
+  auto twisted = [](bool both) {
+    MappedMesh c{test::random_blob(5, 23), {}};
+    c.map.S = c.mesh.V.rowwise().normalized();
+    for (Eigen::Index v = 0; v < c.map.S.rows(); ++v) {
+      const Eigen::Vector3d d = c.map.S.row(v).transpose();
+      const double polar = std::acos(std::clamp(std::abs(d.z()), 0.0, 1.0));
+      const double t = (d.z() < 0 && !both ? 0.0 : 3.141592653589793) * std::clamp((1.0 - polar) / 0.8, 0.0, 1.0);
+      c.map.S.row(v) =
+          Eigen::Vector3d(std::cos(t) * d.x() - std::sin(t) * d.y(), std::sin(t) * d.x() + std::cos(t) * d.y(), d.z()).transpose();
+    }
+    return c;
+  };
+  SECTION("the reference's mesh laid on a member is the worse surface: the common remesh's levels") {
+    const std::string col = write_collection(dir, {a, twisted(false)}, "m0");
+    auto r = pipeline::convert_collection({col, dir + "/assets", o});
+    REQUIRE(r.ok());
+    CHECK(r->lod_connectivity == "remesh");
+    const pipeline::Json& c = r->report["lod_connectivity"];
+    CHECK(c["template_folds"]["m1"]["folded_faces"].get<int>() > 0);
+    REQUIRE(c.contains("choice"));
+    CHECK(c["choice"]["template_worst_level0_psnr_db"].get<double>() < c["choice"]["remesh_worst_level0_psnr_db"].get<double>());
+    CHECK(r->lod_connectivity_reason.find("the template m0 laid on every member has a worst level 0 of") == 0);
+    const auto& l0 = r->members[0].assets.lods.levels;
+    const auto& l1 = r->members[1].assets.lods.levels;
+    for (std::size_t k = 0; k < l0.size(); ++k) CHECK(l0[k].mesh.F == l1[k].mesh.F);
+  }
+  SECTION("the reference's mesh folds over on many faces of a member: not even tried") {
+    const std::string col = write_collection(dir, {a, twisted(true)}, "m0");
+    auto r = pipeline::convert_collection({col, dir + "/assets", o});
+    REQUIRE(r.ok());
+    CHECK(r->lod_connectivity == "remesh");
+    CHECK(r->lod_connectivity_reason.find("the template m0 laid on m1 folds over on") == 0);
+    CHECK_FALSE(r->report["lod_connectivity"].contains("choice"));
   }
 }

@@ -7,8 +7,9 @@
   (env LOD_MODES=original,adaptive,uniform: which of our modes run)
 
 SPHERE = collection:DIR measures member NAME of the consistent collection DIR (its levels from
-`convert --collection`, adaptive: one connectivity for all members) against the peers run on
-MESH alone.
+`convert --collection`: original = the template member's mesh laid on every member, or the
+common remesh where it folds; adaptive = the common remesh; one connectivity for all members
+either way) against the peers run on MESH alone.
 
 Our levels' position bits come from the convert report (the level files carry no quantization
 extras). PEERS_FROM=PREVIOUS.json reuses the peers of an earlier run on the same mesh (only bit
@@ -48,12 +49,12 @@ def interp(points, p):
     return None
 
 # LOD_MODES (comma-separated, default original,adaptive,uniform) picks our modes; CONVERT_ARGS
-# go to original and adaptive. A collection member has no original levels (skipped).
+# go to original and adaptive.
 all_modes = {'original': ['--lod-mode', 'original'] + extra, 'adaptive': ['--lod-mode', 'adaptive'] + extra,
              'uniform': ['--lod-mode', 'uniform']}
 want = os.environ.get('LOD_MODES', 'original,adaptive,uniform').split(',')
-modes = {m: all_modes[m] for m in want if not (m == 'original' and sphere.startswith('collection:'))}
-ours, bits = {}, set()
+modes = {m: all_modes[m] for m in want}
+ours, bits, connectivity = {}, set(), {}
 for mode, args in modes.items():
     if sphere.startswith('collection:'):
         run([sk, 'convert', '--collection', sphere[len('collection:'):], '-o', f'{d}/{mode}_collection',
@@ -61,6 +62,7 @@ for mode, args in modes.items():
         level_file = lambda k: f'{d}/{mode}_collection/{name}_lod{k}.glb'
         report = json.load(open(f'{d}/{mode}_collection/convert_report.json'))
         levels = next(m for m in report['members'] if m['name'] == name)['lods']
+        connectivity[mode] = report.get('lod_connectivity', {}).get('kind')
     else:
         run([sk, 'convert', mesh, sphere, '-o', f'{d}/{mode}.exr', '--lods', '4', '--quiet',
              '--report', f'{d}/{mode}_report.json'] + args)
@@ -90,6 +92,7 @@ for pb in sorted(bits - have):
         peers['gltf-transform'].append({'psnr': psnr(t), 'bytes': os.path.getsize(t), 'position_bits': pb, 'ratio': r})
 
 out = {'mesh': name, 'convert_args': extra, 'ours': ours, 'peers': peers, 'ratios': {}}
+if connectivity: out['lod_connectivity'] = connectivity
 for mode in ours:
     for peer, pts in peers.items():
         row = []

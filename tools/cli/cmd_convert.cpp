@@ -96,9 +96,10 @@ void register_convert(CLI::App& app) {
   cmd->add_option("--lods", args->options.lods, "also write this many glTF levels of detail (default 0: none)");
   cmd->add_option("--lod-mode", args->options.lod_mode,
                   "glTF levels: original (quadric simplification of the mesh itself, texture coordinates into the "
-                  "geometry image, seams at the octahedral fold; single meshes), adaptive (quadric simplification of "
-                  "the remesh; a collection's members share each level's connectivity) or uniform (coarser geometry "
-                  "images)")
+                  "geometry image, seams at the octahedral fold; with --collection the reference member's mesh laid on "
+                  "every member, or the remesh's levels where it folds over on one), adaptive (quadric simplification "
+                  "of the remesh) or uniform (coarser geometry images); a collection's members share each level's "
+                  "connectivity")
       ->transform(CLI::CheckedTransformer(std::map<std::string, convert::LodMode>{
           {"uniform", convert::LodMode::Uniform}, {"adaptive", convert::LodMode::Adaptive}, {"original", convert::LodMode::Original}}));
   cmd->add_flag("!--no-lod-normals", args->options.lod_normals,

@@ -42,7 +42,11 @@ inline constexpr const char* kConvert =
     "NAME_disp.exr per member, collection_morph.glb (one glTF, the members as morph targets),\n"
     "and convert_report.json (per member sizes and PSNRs, and per feature the texel that holds\n"
     "it in every image). All members share one layout: the same texel, cage vertex, glTF\n"
-    "vertex is the same place on every member. The folder appears only when complete.\n"
+    "vertex is the same place on every member. Each LOD level has one connectivity on every\n"
+    "member (collection_morph_lodK.glb per level): the reference member's own mesh laid on\n"
+    "every member through the consistent maps, unless it folds over on more than 1% of its\n"
+    "faces on some member, then the common remesh simplified (report: lod_connectivity).\n"
+    "The folder appears only when complete.\n"
     "Exit codes: 2 bad flags (e.g.\n"
     "--size not 2^k+1), 3 bad input (including a folded map), 4 I/O error.";
 inline constexpr const char* kConvertExamples =

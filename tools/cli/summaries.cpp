@@ -102,6 +102,10 @@ void print_collection_summary(const pipeline::ConvertCollectionResult& r) {
               o.lods > 0 ? format_text(", %d glTF LODs", o.lods).c_str() : "",
               o.cage > 0 ? format_text(", cage %d + %s displacement", o.cage, pipeline::displacement_kind_name(o.displacement)).c_str() : "",
               r.wall_seconds);
+  if (r.lod_connectivity == "template")
+    std::fprintf(stderr, "  LODs: %s's mesh laid on every member (one connectivity per level)\n", r.lod_template.c_str());
+  else if (!r.lod_connectivity_reason.empty())
+    std::fprintf(stderr, "  LODs: the common remesh simplified, because %s\n", r.lod_connectivity_reason.c_str());
 }
 
 void print_collection_warning(const pipeline::MakeCollectionResult& r) {

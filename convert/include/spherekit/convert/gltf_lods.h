@@ -44,6 +44,7 @@
 
 #include "spherekit/convert/gltf_draco.h"
 #include "spherekit/convert/gltf_mesh.h"
+#include "spherekit/convert/template_lods.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/progress.h"
 #include "spherekit/status.h"
@@ -178,6 +179,20 @@ struct GltfLods {
 [[nodiscard]] Result<std::vector<GltfLods>> build_consistent_gltf_lods(const std::vector<GeometryImage>& members,
                                                                       const std::vector<GltfLodOptions>& options,
                                                                       const ProgressFn& progress = {});
+
+/// The levels of detail of a consistent collection on its template member's own mesh laid on
+/// every member (template_lods.h; the collections' LodMode::Original): level k has one
+/// connectivity in every member (GltfLodLevel::mesh), the template's levels are its
+/// original-mesh levels, the other members' are the template's triangulation on their
+/// surfaces. `members` as given to lay_template; `options[m]` as build_consistent_gltf_lods
+/// (levels and lod0_max_vertices of options[0] apply to all); each member's level errors are
+/// its distance to members[m].mesh. Errors: those of template_lod_meshes and build_gltf_lods;
+/// InvalidArgument (options or layout not one per member).
+[[nodiscard]] Result<std::vector<GltfLods>> build_template_gltf_lods(const TemplateLayout& layout,
+                                                                    const std::vector<TemplateLodMember>& members,
+                                                                    int texture_size,
+                                                                    const std::vector<GltfLodOptions>& options,
+                                                                    const ProgressFn& progress = {});
 
 /// The images of `levels` levels of detail of `mesh` through its sphere map `S`: level 0 is
 /// `finest` (moved in), level k is sampled at (N-1)/2^k + 1 with `options` (so with

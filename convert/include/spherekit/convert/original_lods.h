@@ -47,6 +47,13 @@ struct FoldCutMesh {
   RowMat3d S;                           ///< unit sphere point of every vertex (exact 0 on the planes)
   std::vector<std::uint8_t> hole_faces; ///< per face: 1 if it closes a hole of the original
   int original_vertices = 0;            ///< the first vertices are the original's, in order
+  /// A vertex the cut made on an edge: at a + t (b - a) (a, b earlier vertices, a < b).
+  struct EdgePoint {
+    int a = 0, b = 0;
+    double t = 0;
+  };
+  /// The cut's vertices, which are the last edge_points.size() vertices, in order.
+  std::vector<EdgePoint> edge_points;
 };
 
 /// Closes `mesh`'s holes (fill_holes; the centre's sphere point is the normalized mean of its
@@ -78,5 +85,20 @@ struct OriginalLodOptions {
 [[nodiscard]] Result<std::vector<GltfMesh>> original_lod_meshes(const TriMesh& mesh, const RowMat3d& S,
                                                                 const OriginalLodOptions& options = {},
                                                                 const ProgressFn& progress = {});
+
+/// InvalidArgument unless levels is 1..16, texture_size 2^k+1 and lod0_max_vertices >= 0.
+Status check_original_lod_options(const OriginalLodOptions& options);
+
+/// The levels of one or more members that share the fold-cut connectivity `cut`: member m's
+/// vertex v is at P.row(v).segment<3>(3 m) (P has 3n columns; cut.mesh.V for one member).
+/// One simplification in R^3n (memoryless quadrics of 2-planes in R^3n: every member's
+/// distance at once, as the n-D quadric of Asirvatham et al. 2005 step 4), so result[k][m]
+/// has the same faces, points, texture coordinates and position_index for every m; normals
+/// are each member's own. Level vertex counts as original_lod_meshes (from
+/// cut.original_vertices). Errors: InvalidArgument (options, P's shape or non-finite
+/// values), those of build_progressive_mesh.
+[[nodiscard]] Result<std::vector<std::vector<GltfMesh>>> fold_cut_lod_meshes(const FoldCutMesh& cut, const RowMatXd& P,
+                                                                            const OriginalLodOptions& options,
+                                                                            const ProgressFn& progress = {});
 
 }  // namespace spherekit::convert

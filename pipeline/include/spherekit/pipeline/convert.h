@@ -160,6 +160,14 @@ struct ConvertedMember {
 struct ConvertCollectionResult {
   ConvertCollectionJob job;
   std::vector<ConvertedMember> members;
+  /// The levels' common connectivity (LodMode Original and Adaptive): "template" (the template
+  /// member's mesh laid on every member, convert/template_lods.h) or "remesh" (the common
+  /// geometry-image remesh, adaptive_lods.h); empty without such levels.
+  std::string lod_connectivity;
+  std::string lod_connectivity_reason;  ///< why Original took the remesh's levels, else empty
+  std::string lod_template;             ///< the template member (Original), else empty
+  Json lod_template_folds;              ///< per member: folded faces of the laid template (Original)
+  Json lod_choice;                      ///< Original: both candidates' worst level-0 PSNR, when both were made
   Json report;  ///< convert_report.json as written
   double wall_seconds = 0;
 };

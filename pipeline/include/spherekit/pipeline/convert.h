@@ -167,7 +167,7 @@ struct ConvertCollectionResult {
   std::string lod_connectivity_reason;  ///< why Original took the remesh's levels, else empty
   std::string lod_template;             ///< the template member (Original), else empty
   Json lod_template_folds;              ///< per member: folded faces of the laid template (Original)
-  Json lod_choice;                      ///< Original: both candidates' worst level-0 PSNR, when both were made
+  Json lod_choice;                      ///< Original: both candidates' worst member PSNR per level, when both were made
   Json report;  ///< convert_report.json as written
   double wall_seconds = 0;
 };

@@ -167,10 +167,9 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
   }
   // glTF levels of detail: the position bits come from the error budget of the image's own
   // remesh error (when measured), the PSNR of each level is that of the decoded glTF geometry.
-  // Adaptive levels of a collection member are built for all members at once (one
-  // connectivity, convert_collection).
-  // Original (the mesh itself simplified) is for single meshes; a collection's members share
-  // the adaptive levels of their remeshes.
+  // A collection member's adaptive or original levels are built for all members at once (one
+  // connectivity per level: the reference's mesh laid on every member, or the common remesh;
+  // convert_collection).
   const bool adaptive = o.lod_mode != convert::LodMode::Uniform;
   if (o.lods > 0 && !(adaptive && collection_member)) {
     Stopwatch gltf_time;

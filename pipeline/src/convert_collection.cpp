@@ -27,7 +27,8 @@ namespace {
 // even tried (see template_or_remesh_levels): a folded face is a hole and a fin in that
 // member's levels.
 constexpr double kMaxTemplateFolds = 0.05;
-// Points sampled per direction for that choice when the PSNRs themselves are not asked for.
+// Points sampled per direction for each PSNR of that choice (2 candidates x members x levels
+// of them; the candidates differ by several dB where it matters, see template_or_remesh_levels).
 constexpr int kChoiceSamples = 20000;
 
 // Per level, the worst member's PSNR of `lods` (each decoded level against the member's mesh).
@@ -94,7 +95,7 @@ Result<std::vector<convert::GltfLods>> template_or_remesh_levels(const std::vect
   SPHEREKIT_ASSIGN_OR_RETURN(std::vector<convert::GltfLods> laid,
                              convert::build_template_gltf_lods(layout, tm, o.size, lod_options, progress));
   RemeshErrorOptions psnr;
-  psnr.samples = std::max(o.psnr_samples, kChoiceSamples);
+  psnr.samples = kChoiceSamples;
   psnr.threads = o.threads;
   const std::vector<double> laid_psnr = worst_member_psnr(members, laid, psnr);
   const std::vector<double> remesh_psnr = worst_member_psnr(members, remesh, psnr);

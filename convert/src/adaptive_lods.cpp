@@ -180,6 +180,8 @@ Result<std::vector<std::vector<GltfMesh>>> adaptive_lod_meshes(const std::vector
   ProgressiveMeshOptions pm_options;
   pm_options.constraint_edges = seam_edges(n, welded);
   pm_options.degenerate_faces_free = true;  // hole texels sit on the rim (progressive_mesh.h)
+  // A level's error is each member's own surface error (progressive_mesh.h, model_planes).
+  pm_options.model_planes = true;
   std::vector<std::uint8_t> hole_faces;
   if (options.drop_hole_faces) hole_faces = geometry_image_hole_faces(members[0]);
   if (!hole_faces.empty()) {

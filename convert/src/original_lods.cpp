@@ -222,8 +222,11 @@ Result<std::vector<std::vector<GltfMesh>>> fold_cut_lod_meshes(const FoldCutMesh
   // Memoryless quadrics (the distances to the current level's planes) and a light edge-length
   // tie-break: the bunny's levels 1-3 are 3.6/3.9/2.0 dB better than with accumulated quadrics
   // and the remesh's tie-break 0.01, at the same vertex counts (eval-surface of the files).
-  // With several members the planes are 2-planes in R^3n (every member's distance at once).
+  // With several members, each member's distance to its own planes, summed (model_planes in
+  // progressive_mesh.h: the 2-plane in R^3n also charges the members' tangential
+  // disagreement, which is no error of a level).
   pm_options.memoryless = true;
+  pm_options.model_planes = true;
   pm_options.edge_length_weight = 0.001;
   pm_options.degenerate_faces_free = true;  // the cut leaves slivers where it passes near a vertex
   pm_options.face_weights.assign(cut.hole_faces.size(), 1.0);

@@ -125,6 +125,11 @@ class Simplifier {
       : P_(P), opt_(opt), d_(static_cast<int>(P.cols())), nv_(static_cast<int>(P.rows())) {
     const int nf = static_cast<int>(F.rows());
     build_quadric_coordinates(F);
+    if (opt_.model_planes) {
+      for (int b = 0; b + 2 < d_; b += 3) plane_blocks_.push_back({b, b + 3});
+    } else {
+      plane_blocks_.push_back({0, qd_});
+    }
     faces_.resize(static_cast<size_t>(nf));
     face_alive_.assign(static_cast<size_t>(nf), 1);
     vf_.resize(static_cast<size_t>(nv_));
@@ -144,7 +149,12 @@ class Simplifier {
       double area = face_area(faces_[f]) * w;
       if (!opt_.memoryless) {
         detail::QuadricND q(qd_);
-        q.add_triangle(X_.row(F(f, 0)).data(), X_.row(F(f, 1)).data(), X_.row(F(f, 2)).data(), area);
+        const double* x[3] = {X_.row(F(f, 0)).data(), X_.row(F(f, 1)).data(), X_.row(F(f, 2)).data()};
+        if (opt_.model_planes) {
+          for (int b = 0; b + 2 < d_; b += 3) q.add_triangle(x[0], x[1], x[2], w * block_area(faces_[f], b), b, b + 3);
+        } else {
+          q.add_triangle(x[0], x[1], x[2], area);
+        }
         for (int k = 0; k < 3; ++k) quadric_[static_cast<size_t>(F(f, k))].add(q);
       }
       for (int k = 0; k < 3; ++k) area_[static_cast<size_t>(F(f, k))] += area / 3.0;
@@ -211,13 +221,15 @@ class Simplifier {
   double face_area(const std::array<int, 3>& f) const {
     // Sum of the 3D areas of each model block (d = 3n): one weight for all models.
     double a = 0;
-    for (int b = 0; b + 2 < d_; b += 3) {
-      Eigen::Vector3d p0 = P_.row(f[0]).segment<3>(b).transpose();
-      Eigen::Vector3d p1 = P_.row(f[1]).segment<3>(b).transpose();
-      Eigen::Vector3d p2 = P_.row(f[2]).segment<3>(b).transpose();
-      a += 0.5 * (p1 - p0).cross(p2 - p0).norm();
-    }
+    for (int b = 0; b + 2 < d_; b += 3) a += block_area(f, b);
     return a;
+  }
+  // The 3D area of face f in the model block starting at column b.
+  double block_area(const std::array<int, 3>& f, int b) const {
+    Eigen::Vector3d p0 = P_.row(f[0]).segment<3>(b).transpose();
+    Eigen::Vector3d p1 = P_.row(f[1]).segment<3>(b).transpose();
+    Eigen::Vector3d p2 = P_.row(f[2]).segment<3>(b).transpose();
+    return 0.5 * (p1 - p0).cross(p2 - p0).norm();
   }
 
   // Quadric coordinates: the positions, and with normal_weight > 0 each model's unit vertex
@@ -256,7 +268,6 @@ class Simplifier {
   // vs contain it). It measures the current level, not the original surface, so coarse
   // levels keep what is still visible at their scale.
   double memoryless_error(int vt, int vs) const {
-    const int d = qd_;
     const double* x = X_.row(vs).data();
     double sum = 0;
     for (int f : vf_[vt]) {
@@ -264,19 +275,24 @@ class Simplifier {
       const double* x0 = X_.row(c[0]).data();
       const double* x1 = X_.row(c[1]).data();
       const double* x2 = X_.row(c[2]).data();
-      double e1e1 = 0, e1e2 = 0, e2e2 = 0, re1 = 0, re2 = 0, rr = 0;
-      for (int i = 0; i < d; ++i) {
-        const double e1 = x1[i] - x0[i], e2 = x2[i] - x0[i], r = x[i] - x0[i];
-        e1e1 += e1 * e1, e1e2 += e1 * e2, e2e2 += e2 * e2, re1 += r * e1, re2 += r * e2, rr += r * r;
+      for (const auto& [begin, end] : plane_blocks()) {
+        double e1e1 = 0, e1e2 = 0, e2e2 = 0, re1 = 0, re2 = 0, rr = 0;
+        for (int i = begin; i < end; ++i) {
+          const double e1 = x1[i] - x0[i], e2 = x2[i] - x0[i], r = x[i] - x0[i];
+          e1e1 += e1 * e1, e1e2 += e1 * e2, e2e2 += e2 * e2, re1 += r * e1, re2 += r * e2, rr += r * r;
+        }
+        const double det = e1e1 * e2e2 - e1e2 * e1e2;
+        if (!(det > 1e-24 * e1e1 * e2e2)) continue;
+        // Squared distance to the 2-plane: |r|^2 - r^T E (E^T E)^-1 E^T r.
+        const double proj = (e2e2 * re1 * re1 - 2 * e1e2 * re1 * re2 + e1e1 * re2 * re2) / det;
+        sum += (opt_.model_planes ? block_area(c, begin) : face_area(c)) * std::max(0.0, rr - proj);
       }
-      const double det = e1e1 * e2e2 - e1e2 * e1e2;
-      if (!(det > 1e-24 * e1e1 * e2e2)) continue;
-      // Squared distance to the 2-plane: |r|^2 - r^T E (E^T E)^-1 E^T r.
-      const double proj = (e2e2 * re1 * re1 - 2 * e1e2 * re1 * re2 + e1e1 * re2 * re2) / det;
-      sum += face_area(c) * std::max(0.0, rr - proj);
     }
     return sum;
   }
+  // The coordinate ranges whose planes a cost measures: all qd_ coordinates at once (the
+  // 2-plane in R^d), or each model's block (model_planes).
+  const std::vector<std::pair<int, int>>& plane_blocks() const { return plane_blocks_; }
 
   double cost(int vt, int vs) const {
     const double* ps = P_.row(vs).data();
@@ -351,31 +367,32 @@ class Simplifier {
   struct PlaneTerm {
     const double *x0, *x1, *x2;
     double e1e1, e1e2, e2e2, det, area;
+    int begin, end;  // the coordinates the plane lives in (plane_blocks)
   };
   void prepare_memoryless(int vt) {
     planes_.clear();
-    const int d = qd_;
     for (int f : vf_[vt]) {
       const auto& c = faces_[f];
-      PlaneTerm t{X_.row(c[0]).data(), X_.row(c[1]).data(), X_.row(c[2]).data(), 0, 0, 0, 0, 0};
-      for (int i = 0; i < d; ++i) {
-        const double e1 = t.x1[i] - t.x0[i], e2 = t.x2[i] - t.x0[i];
-        t.e1e1 += e1 * e1, t.e1e2 += e1 * e2, t.e2e2 += e2 * e2;
+      for (const auto& [begin, end] : plane_blocks()) {
+        PlaneTerm t{X_.row(c[0]).data(), X_.row(c[1]).data(), X_.row(c[2]).data(), 0, 0, 0, 0, 0, begin, end};
+        for (int i = begin; i < end; ++i) {
+          const double e1 = t.x1[i] - t.x0[i], e2 = t.x2[i] - t.x0[i];
+          t.e1e1 += e1 * e1, t.e1e2 += e1 * e2, t.e2e2 += e2 * e2;
+        }
+        t.det = t.e1e1 * t.e2e2 - t.e1e2 * t.e1e2;
+        if (!(t.det > 1e-24 * t.e1e1 * t.e2e2)) continue;
+        t.area = opt_.model_planes ? block_area(c, begin) : face_area(c);
+        planes_.push_back(t);
       }
-      t.det = t.e1e1 * t.e2e2 - t.e1e2 * t.e1e2;
-      if (!(t.det > 1e-24 * t.e1e1 * t.e2e2)) continue;
-      t.area = face_area(c);
-      planes_.push_back(t);
     }
   }
   // cost(vt, vs) with memoryless quadrics, from prepare_memoryless(vt).
   double memoryless_cost(int vt, int vs) const {
-    const int d = qd_;
     const double* x = X_.row(vs).data();
     double sum = 0;
     for (const PlaneTerm& t : planes_) {
       double re1 = 0, re2 = 0, rr = 0;
-      for (int i = 0; i < d; ++i) {
+      for (int i = t.begin; i < t.end; ++i) {
         const double e1 = t.x1[i] - t.x0[i], e2 = t.x2[i] - t.x0[i], r = x[i] - t.x0[i];
         re1 += r * e1, re2 += r * e2, rr += r * r;
       }
@@ -603,6 +620,7 @@ class Simplifier {
   const ProgressiveMeshOptions& opt_;
   int d_, nv_;
   int qd_ = 0;   // quadric dimension: d_, or 2 d_ with normals
+  std::vector<std::pair<int, int>> plane_blocks_;  // plane_blocks()
   RowMatXd X_;   // quadric coordinates per vertex (positions, weighted normals)
   int alive_count_ = 0;
   std::vector<std::array<int, 3>> faces_;
@@ -638,6 +656,8 @@ Result<ProgressiveMesh> build_progressive_mesh(const RowMatXd& P, const RowMat3i
     return Status(ErrorCode::InvalidArgument, "face_weights must have one entry per face");
   if (!options.keep_vertices.empty() && options.keep_vertices.size() != static_cast<size_t>(P.rows()))
     return Status(ErrorCode::InvalidArgument, "keep_vertices must have one entry per vertex");
+  if (options.model_planes && options.normal_weight > 0)
+    return Status(ErrorCode::InvalidArgument, "model_planes measures positions only (normal_weight must be 0)");
   for (const auto& e : options.constraint_edges)
     if (e[0] < 0 || e[1] < 0 || e[0] >= P.rows() || e[1] >= P.rows() || e[0] == e[1])
       return Status(ErrorCode::InvalidArgument, "constraint edge index out of range");

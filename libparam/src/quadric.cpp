@@ -9,8 +9,10 @@
 
 namespace spherekit::detail {
 
-void QuadricND::add_triangle(const double* p0, const double* p1, const double* p2, double weight) {
-  const int d = d_;
+void QuadricND::add_triangle(const double* p0, const double* p1, const double* p2, double weight, int begin,
+                             int end) {
+  const int d = end - begin;
+  p0 += begin, p1 += begin, p2 += begin;
   std::vector<double> e1(static_cast<size_t>(d)), e2(static_cast<size_t>(d));
   double l1 = 0;
   for (int i = 0; i < d; ++i) {
@@ -38,11 +40,14 @@ void QuadricND::add_triangle(const double* p0, const double* p1, const double* p
     pe2 += p0[i] * e2[i];
     pp += p0[i] * p0[i];
   }
-  size_t k = 0;
-  for (int i = 0; i < d; ++i)
+  // Packed upper triangle, row-major: row r starts at r d_ - r (r - 1) / 2 = r (2 d_ - r + 1) / 2.
+  for (int i = 0; i < d; ++i) {
+    const int r = begin + i;
+    size_t k = static_cast<size_t>(r) * static_cast<size_t>(2 * d_ - r + 1) / 2;
     for (int j = i; j < d; ++j, ++k)
       a_[k] += weight * ((i == j ? 1.0 : 0.0) - e1[i] * e1[j] - e2[i] * e2[j]);
-  for (int i = 0; i < d; ++i) b_[i] += weight * (pe1 * e1[i] + pe2 * e2[i] - p0[i]);
+  }
+  for (int i = 0; i < d; ++i) b_[static_cast<size_t>(begin + i)] += weight * (pe1 * e1[i] + pe2 * e2[i] - p0[i]);
   c_ += weight * (pp - pe1 * pe1 - pe2 * pe2);
 }
 

@@ -1,6 +1,8 @@
 // Progressive mesh: collapses down to a tetrahedron, exact replay, n-D coordinates.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -157,4 +159,65 @@ TEST_CASE("n-D quadric measures squared distance to the triangle's plane", "[par
   CHECK(q6.evaluate(y) == Approx(0.0).margin(1e-12));
   double z[6] = {0.2, 0.3, 1, 0.2 + 1.0, 0.3, 1};  // offset (0,0,0,1,0,0) -> distance^2 = 1/2
   CHECK(q6.evaluate(z) == Approx(0.5));
+}
+
+TEST_CASE("n-D quadric of one coordinate block measures that block's plane distance alone", "[param][pm]") {
+  // The triangle of block [3, 6) lies in the plane y = 2 there; block [0, 3) is arbitrary.
+  double a0[6] = {7, 1, 3, 0, 2, 0}, a1[6] = {-4, 0, 5, 1, 2, 0}, a2[6] = {2, 9, 1, 0, 2, 1};
+  detail::QuadricND q(6);
+  q.add_triangle(a0, a1, a2, 3.0, 3, 6);
+  double x[6] = {100, -50, 25, 0.4, 2.5, -7};  // block [3, 6) is 0.5 from the plane
+  CHECK(q.evaluate(x) == Approx(3.0 * 0.25));
+  x[0] = -3, x[1] = 8, x[3] = 11, x[5] = 4;  // moves within the plane and in the other block
+  CHECK(q.evaluate(x) == Approx(3.0 * 0.25));
+  // The whole range is the plain 2-plane quadric, to the bit.
+  detail::QuadricND whole(6), range(6);
+  whole.add_triangle(a0, a1, a2, 1.5);
+  range.add_triangle(a0, a1, a2, 1.5, 0, 6);
+  CHECK(whole.evaluate(x) == range.evaluate(x));
+}
+
+// Levels of detail of n models (model_planes): each model's own plane distances. For one
+// model the option changes nothing (the same collapses); for two models it still makes a
+// valid progressive mesh down to a tetrahedron; it refuses the normal term.
+TEST_CASE("progressive mesh: model planes", "[param][pm]") {
+  TriMesh a = test::random_blob(2, 7), b = test::random_blob(2, 8);  // same connectivity
+  for (bool memoryless : {false, true}) {
+    auto build = [&](const RowMatXd& P, bool model_planes) {
+      ProgressiveMeshOptions opt;
+      opt.memoryless = memoryless;
+      opt.model_planes = model_planes;
+      auto pm = build_progressive_mesh(P, a.F, opt);
+      REQUIRE(pm.ok());
+      return *pm;
+    };
+    RowMatXd one = a.V;
+    const ProgressiveMesh plain = build(one, false), planes = build(one, true);
+    REQUIRE(plain.collapses.size() == planes.collapses.size());
+    int differ = 0;
+    for (size_t i = 0; i < plain.collapses.size(); ++i)
+      differ += plain.collapses[i].vt != planes.collapses[i].vt || plain.collapses[i].vs != planes.collapses[i].vs;
+    CHECK(differ == 0);
+    RowMatXd two(a.V.rows(), 6);
+    two.leftCols(3) = a.V;
+    two.rightCols(3) = b.V;
+    const ProgressiveMesh joint = build(two, false), own = build(two, true);
+    CHECK(own.base_vertices.size() == 4);
+    std::vector<std::array<int, 3>> F(static_cast<size_t>(a.F.rows()));
+    for (Eigen::Index f = 0; f < a.F.rows(); ++f) F[static_cast<size_t>(f)] = {a.F(f, 0), a.F(f, 1), a.F(f, 2)};
+    std::vector<char> alive(F.size(), 1);
+    CHECK(is_closed_manifold(replay_forward(own, F, alive)));
+    // The two costs differ, so the orders do.
+    int order_differs = 0;
+    for (size_t i = 0; i < std::min(joint.collapses.size(), own.collapses.size()); ++i)
+      order_differs += joint.collapses[i].vt != own.collapses[i].vt;
+    CHECK(order_differs > 0);
+  }
+  ProgressiveMeshOptions bad;
+  bad.model_planes = true;
+  bad.normal_weight = 0.02;
+  RowMatXd P = a.V;
+  auto refused = build_progressive_mesh(P, a.F, bad);
+  REQUIRE_FALSE(refused.ok());
+  CHECK(refused.status().code() == ErrorCode::InvalidArgument);
 }

@@ -21,7 +21,12 @@ class QuadricND {
 
   /// Quadric of the 2-plane through triangle (p0, p1, p2) in R^d, weighted by `weight`.
   /// A degenerate triangle (zero area) adds nothing.
-  void add_triangle(const double* p0, const double* p1, const double* p2, double weight);
+  void add_triangle(const double* p0, const double* p1, const double* p2, double weight) {
+    add_triangle(p0, p1, p2, weight, 0, d_);
+  }
+  /// The same for the coordinates [begin, end) alone (one model's block of a point in
+  /// R^3n): the squared distance of x's block to the triangle's plane in that block.
+  void add_triangle(const double* p0, const double* p1, const double* p2, double weight, int begin, int end);
 
   /// this += other
   void add(const QuadricND& other);

@@ -21,7 +21,9 @@
 // Collections (Asirvatham et al. 2005 §3, the R^3n mesh of step 4/5): the members' remeshes
 // share one connectivity (consistent maps: same texels), so ONE simplification of the mesh
 // whose vertex i is every member's vertex i stacked in R^3n gives every member the same
-// faces and points at every level; the n-D quadric measures the error of all members at once.
+// faces and points at every level; the quadrics measure the error of all members at once, each
+// member's distance to its own face planes summed (ProgressiveMeshOptions::model_planes: the
+// 2-plane in R^3n would also charge the members' tangential disagreement, no error of a level).
 // Each level's members therefore still make a morph-target glTF (gltf_morph.h).
 //
 // Level k has max(6, round(L / 4^k)) vertices, L = V * lod0_vertex_fraction (V the remesh's)

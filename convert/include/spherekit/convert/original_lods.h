@@ -91,8 +91,8 @@ Status check_original_lod_options(const OriginalLodOptions& options);
 
 /// The levels of one or more members that share the fold-cut connectivity `cut`: member m's
 /// vertex v is at P.row(v).segment<3>(3 m) (P has 3n columns; cut.mesh.V for one member).
-/// One simplification in R^3n (memoryless quadrics of 2-planes in R^3n: every member's
-/// distance at once, as the n-D quadric of Asirvatham et al. 2005 step 4), so result[k][m]
+/// One simplification in R^3n (memoryless quadrics: every member's distance to its own face
+/// planes, summed, ProgressiveMeshOptions::model_planes), so result[k][m]
 /// has the same faces, points, texture coordinates and position_index for every m; normals
 /// are each member's own. Level vertex counts as original_lod_meshes (from
 /// cut.original_vertices). Errors: InvalidArgument (options, P's shape or non-finite

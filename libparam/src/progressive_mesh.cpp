@@ -263,42 +263,12 @@ class Simplifier {
     X_.rightCols(d_) = opt_.normal_weight * N;
   }
 
-  // Memoryless quadric (Lindstrom & Turk 1998; MeshSimplify -minqem): the area-weighted
-  // squared distances of vs's point to the planes of the faces now around vt (those around
-  // vs contain it). It measures the current level, not the original surface, so coarse
-  // levels keep what is still visible at their scale.
-  double memoryless_error(int vt, int vs) const {
-    const double* x = X_.row(vs).data();
-    double sum = 0;
-    for (int f : vf_[vt]) {
-      const auto& c = faces_[f];
-      const double* x0 = X_.row(c[0]).data();
-      const double* x1 = X_.row(c[1]).data();
-      const double* x2 = X_.row(c[2]).data();
-      for (const auto& [begin, end] : plane_blocks()) {
-        double e1e1 = 0, e1e2 = 0, e2e2 = 0, re1 = 0, re2 = 0, rr = 0;
-        for (int i = begin; i < end; ++i) {
-          const double e1 = x1[i] - x0[i], e2 = x2[i] - x0[i], r = x[i] - x0[i];
-          e1e1 += e1 * e1, e1e2 += e1 * e2, e2e2 += e2 * e2, re1 += r * e1, re2 += r * e2, rr += r * r;
-        }
-        const double det = e1e1 * e2e2 - e1e2 * e1e2;
-        if (!(det > 1e-24 * e1e1 * e2e2)) continue;
-        // Squared distance to the 2-plane: |r|^2 - r^T E (E^T E)^-1 E^T r.
-        const double proj = (e2e2 * re1 * re1 - 2 * e1e2 * re1 * re2 + e1e1 * re2 * re2) / det;
-        sum += (opt_.model_planes ? block_area(c, begin) : face_area(c)) * std::max(0.0, rr - proj);
-      }
-    }
-    return sum;
-  }
-  // The coordinate ranges whose planes a cost measures: all qd_ coordinates at once (the
-  // 2-plane in R^d), or each model's block (model_planes).
-  const std::vector<std::pair<int, int>>& plane_blocks() const { return plane_blocks_; }
-
   double cost(int vt, int vs) const {
     const double* ps = P_.row(vs).data();
     const double* pt = P_.row(vt).data();
     const double* xs = X_.row(vs).data();
-    double q = opt_.memoryless ? memoryless_error(vt, vs) : quadric_[vt].evaluate(xs) + quadric_[vs].evaluate(xs);
+    // Accumulated quadrics only: memoryless costs come from prepare_memoryless / memoryless_cost.
+    const double q = quadric_[vt].evaluate(xs) + quadric_[vs].evaluate(xs);
     double len2 = 0;
     for (int i = 0; i < d_; ++i) len2 += (ps[i] - pt[i]) * (ps[i] - pt[i]);
     return q + opt_.edge_length_weight * len2 * area_[vt];
@@ -361,19 +331,22 @@ class Simplifier {
     choose_best(vt);
   }
 
-  // memoryless_error's per-face terms that do not depend on vs (the edge Gram matrix and
-  // the area), once per refresh instead of once per (face, vs): the same operations in the
-  // same order, so the same costs to the bit.
+  // Memoryless quadric (Lindstrom & Turk 1998; MeshSimplify -minqem): the area-weighted
+  // squared distances of vs's point to the planes of the faces now around vt (those around
+  // vs contain it). It measures the current level, not the original surface, so coarse
+  // levels keep what is still visible at their scale. The per-face terms that do not depend
+  // on vs (the edge Gram matrix and the area) are made once per refresh; a plane is the
+  // face's 2-plane in R^qd, or with model_planes one per model block (plane_blocks_).
   struct PlaneTerm {
     const double *x0, *x1, *x2;
     double e1e1, e1e2, e2e2, det, area;
-    int begin, end;  // the coordinates the plane lives in (plane_blocks)
+    int begin, end;  // the coordinates the plane lives in (plane_blocks_)
   };
   void prepare_memoryless(int vt) {
     planes_.clear();
     for (int f : vf_[vt]) {
       const auto& c = faces_[f];
-      for (const auto& [begin, end] : plane_blocks()) {
+      for (const auto& [begin, end] : plane_blocks_) {
         PlaneTerm t{X_.row(c[0]).data(), X_.row(c[1]).data(), X_.row(c[2]).data(), 0, 0, 0, 0, 0, begin, end};
         for (int i = begin; i < end; ++i) {
           const double e1 = t.x1[i] - t.x0[i], e2 = t.x2[i] - t.x0[i];
@@ -620,7 +593,9 @@ class Simplifier {
   const ProgressiveMeshOptions& opt_;
   int d_, nv_;
   int qd_ = 0;   // quadric dimension: d_, or 2 d_ with normals
-  std::vector<std::pair<int, int>> plane_blocks_;  // plane_blocks()
+  // The coordinate ranges a plane lives in: all qd_ coordinates (the 2-plane in R^qd), or
+  // each model's block of 3 (model_planes).
+  std::vector<std::pair<int, int>> plane_blocks_;
   RowMatXd X_;   // quadric coordinates per vertex (positions, weighted normals)
   int alive_count_ = 0;
   std::vector<std::array<int, 3>> faces_;

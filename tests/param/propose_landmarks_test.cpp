@@ -229,6 +229,57 @@ TEST_CASE("propose_landmarks: the ends and sides of corresponding openings, told
   CHECK(worst > 0.05);
 }
 
+// A flat star: five arms of different lengths in the plane z = 0 at uneven azimuths, the body
+// half as thick as it is wide, so every point of its top face has a twin on the bottom face at
+// the same geodesic distances from the arms' tips (the mirror image across z = 0). `stretch`
+// and `squash` scale its length and its thickness (non-isometric changes that keep the mirror
+// symmetry). Vertex v of every such star is the same template point.
+TriMesh flat_star(double stretch, double squash) {
+  const double azimuth[5] = {10, 80, 155, 220, 290}, length[5] = {1.6, 1.1, 1.4, 1.9, 1.25};
+  TriMesh m = test::icosphere(5);
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+    const Eigen::Vector3d p = m.V.row(v).transpose().normalized();
+    double s = 1;
+    for (int a = 0; a < 5; ++a) {
+      const double t = azimuth[a] * std::numbers::pi / 180;
+      s += length[a] * std::pow(std::max(0.0, p.dot(Eigen::Vector3d(std::cos(t), std::sin(t), 0))), 12);
+    }
+    m.V.row(v) = Eigen::Vector3d(stretch * s * p.x(), s * p.y(), 0.5 * squash * s * p.z());
+  }
+  return m;
+}
+
+TEST_CASE("propose_landmarks: further points on the right face of a flat shape (turns, not distances)", "[param]") {
+  // A further point is placed where its distances to the matched landmarks fit the
+  // reference's; on the flat star the top and bottom twins fit alike, so only the turns of the
+  // landmarks seen from the point can tell them apart. Members are stretched and squashed, one
+  // is renumbered.
+  std::vector<TriMesh> meshes = {flat_star(1, 1), flat_star(1.15, 0.85), flat_star(0.9, 1.2)};
+  std::vector<int> perm;
+  meshes[2] = permuted(meshes[2], perm);
+  ProposeLandmarksOptions o;
+  o.reference = 0;
+  o.extra_points = 8;
+  auto r = propose_landmarks(meshes, o);
+  REQUIRE(r.ok());
+  REQUIRE(r->extremities >= 5);
+  REQUIRE(r->names.size() == static_cast<std::size_t>(r->extremities + 8));
+  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
+  int wrong = 0, top_or_bottom = 0;
+  for (std::size_t i = 1; i < meshes.size(); ++i)
+    for (std::size_t k = 0; k < r->names.size(); ++k) {
+      const int v0 = r->landmarks[0][k].vertex;
+      const int v = i == 2 ? perm[v0] : v0;  // the ground-truth partner: the same template vertex
+      const double err = (meshes[i].V.row(r->landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
+      UNSCOPED_INFO("member " << i << " " << r->names[k] << " error " << err);
+      wrong += err > 0.05;
+      // Points off the rim, where the twin is on the other face (a third of the thickness).
+      top_or_bottom += static_cast<int>(k) >= r->extremities && std::abs(meshes[0].V(v0, 2)) > 0.15;
+    }
+  CHECK(top_or_bottom >= 4);
+  CHECK(wrong == 0);
+}
+
 TEST_CASE("propose_landmarks matches a renumbered copy vertex for vertex", "[param]") {
   const TriMesh a = sample_member(0);
   std::vector<int> perm;

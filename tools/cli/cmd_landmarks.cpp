@@ -65,8 +65,9 @@ void register_landmarks(CLI::App& app) {
       "turns of matched triples), leaves out extremities whose peak is as high as another one beyond\n"
       "the tip (a head peaking at the nose on one mesh and at an ear on another), adds the finer\n"
       "peaks (--fine-radius) the sphere maps carry onto each other, optionally adds --extra-points\n"
-      "further points (farthest-point sampling, located by their distances to the matched ones near\n"
-      "where the sphere maps carry them), and writes one `NAME.lm.txt` per mesh (beside it, or\n"
+      "further points (farthest-point sampling, located by their distances to the matched ones,\n"
+      "front told from back by the turns of those seen from the point), and writes one\n"
+      "`NAME.lm.txt` per mesh (beside it, or\n"
       "in --output-dir), the format `consistent` reads. --report writes every match's confidence;\n"
       "members whose left/right cannot be told are flagged there and in the summary.",
       "  spherekit landmarks cats/*.obj --report landmarks.json\n"

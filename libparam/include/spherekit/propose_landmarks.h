@@ -37,9 +37,10 @@
 //    judge the extremities: one whose distances to them disagree with the reference's far more
 //    than theirs do among themselves is left out.
 // 6. Further points by farthest-point sampling on the reference, located on every member by
-//    their geodesic distances to the points already matched (near the point the sphere maps
-//    carry it to, when there are maps: the distances alone cannot tell a torso's front from
-//    its back).
+//    geodesic trilateration (relative differences of their distances to the points already
+//    matched); distances alone cannot tell a torso's front from its back, so among the fit's
+//    best local minima the turns of the landmarks seen from the point decide (the test of
+//    step 3 about one point), weighed against how much worse each fits.
 #pragma once
 
 #include <string>

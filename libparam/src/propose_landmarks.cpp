@@ -462,8 +462,10 @@ constexpr double kSphereInformative = 0.3;
 // relative distance differences log((d + s) / (t + s)) with s = kRelativeSoftening (x
 // sqrt(area): distances much shorter than that are as uncertain as the landmarks' placement);
 // the fit's noise floor per distance (5%: the departure from isometry of posed families), and
-// the weight of a candidate's log fit ratio (above that floor) against its turns' projection.
+// the weight of a candidate's log fit ratio (above that floor) against its turns' projection
+// (the turns of at most kTurnLandmarks landmarks, the nearest).
 constexpr std::size_t kTrilaterationCandidates = 8;
+constexpr std::size_t kTurnLandmarks = 12;
 constexpr double kRelativeSoftening = 0.05;
 constexpr double kRelativeNoise = 0.05;
 constexpr double kFitWeight = 0.5;
@@ -1027,7 +1029,18 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     const int na = static_cast<int>(anchors[ref].size());
     std::vector<double> target;
     for (int f : anchors[ref]) target.push_back(rm.dist[f][pv]);
-    const std::vector<double> ref_turns = triple_turns(meshes[ref], rm, at[ref], pv);
+    // The turns of the kTurnLandmarks landmarks nearest the point (their paths are the
+    // shortest; and the turns of k landmarks cost k^3).
+    std::vector<int> near_lm(na);
+    std::iota(near_lm.begin(), near_lm.end(), 0);
+    std::stable_sort(near_lm.begin(), near_lm.end(), [&](int a, int b) { return target[a] < target[b]; });
+    if (near_lm.size() > kTurnLandmarks) near_lm.resize(kTurnLandmarks);
+    auto turn_points = [&](int i) {
+      std::vector<int> pts;
+      for (int a : near_lm) pts.push_back(at[i][a]);
+      return pts;
+    };
+    const std::vector<double> ref_turns = triple_turns(meshes[ref], rm, turn_points(ref), pv);
     double ref_norm = 0;
     for (double t : ref_turns) ref_norm += t * t;
     for (int i = 0; i < nm; ++i) {
@@ -1061,7 +1074,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
         for (int c : minima) {
           double proj = 0;
           if (ref_norm > 0) {
-            const std::vector<double> turns = triple_turns(meshes[i], m, at[i], c);
+            const std::vector<double> turns = triple_turns(meshes[i], m, turn_points(i), c);
             for (std::size_t q = 0; q < turns.size(); ++q) proj += ref_turns[q] * turns[q];
             proj = std::clamp(proj / ref_norm, -1.0, 1.0);
           }

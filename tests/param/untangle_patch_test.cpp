@@ -135,3 +135,34 @@ TEST_CASE("untangle_patch is deterministic", "[untangle]") {
   REQUIRE(detail::untangle_patch(pm, soup.X, fixed, bad, 4, &B));
   CHECK(A == B);
 }
+
+TEST_CASE("grow_rings: the vertices within k face rings, sorted and unique, against breadth-first search", "[untangle]") {
+  const TriMesh m = icosphere(3);
+  SoupForUntangle soup(m);
+  const detail::PatchMesh mesh{&soup.F, &soup.vf};
+  // Face-ring distance from the seeds by breadth-first search over the faces' corners.
+  auto reference = [&](const std::vector<int>& seeds, int rings) {
+    std::vector<int> depth(soup.vf.size(), -1), queue;
+    for (int s : seeds)
+      if (depth[static_cast<size_t>(s)] < 0) depth[static_cast<size_t>(s)] = 0, queue.push_back(s);
+    for (size_t q = 0; q < queue.size(); ++q) {
+      const int v = queue[q];
+      if (depth[static_cast<size_t>(v)] == rings) continue;
+      for (int f : soup.vf[static_cast<size_t>(v)])
+        for (int w : soup.F[static_cast<size_t>(f)])
+          if (depth[static_cast<size_t>(w)] < 0) depth[static_cast<size_t>(w)] = depth[static_cast<size_t>(v)] + 1, queue.push_back(w);
+    }
+    std::vector<int> out;
+    for (size_t v = 0; v < depth.size(); ++v)
+      if (depth[v] >= 0) out.push_back(static_cast<int>(v));
+    return out;
+  };
+  const std::vector<std::vector<int>> seeds = {{5}, {300, 7, 300, 12}, {0, 641, 320}};
+  for (const auto& s : seeds)
+    for (int rings : {0, 1, 2, 5, 40}) {
+      const std::vector<int> got = detail::grow_rings(mesh, s, rings);
+      CHECK(got == reference(s, rings));
+      CHECK(std::is_sorted(got.begin(), got.end()));
+    }
+  CHECK(detail::grow_rings(mesh, {5}, 40).size() == soup.vf.size());  // the whole sphere
+}

@@ -1070,11 +1070,12 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
         std::sort(minima.begin(), minima.end(), [&](int a, int b) { return fv[a] < fv[b] || (fv[a] == fv[b] && a < b); });
         if (minima.size() > kTrilaterationCandidates) minima.resize(kTrilaterationCandidates);
         const double floor = na * kRelativeNoise * kRelativeNoise;
+        const std::vector<int> pts = turn_points(i);
         double best_score = -kInf;
         for (int c : minima) {
           double proj = 0;
           if (ref_norm > 0) {
-            const std::vector<double> turns = triple_turns(meshes[i], m, turn_points(i), c);
+            const std::vector<double> turns = triple_turns(meshes[i], m, pts, c);
             for (std::size_t q = 0; q < turns.size(); ++q) proj += ref_turns[q] * turns[q];
             proj = std::clamp(proj / ref_norm, -1.0, 1.0);
           }
@@ -1086,7 +1087,10 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
       add_landmark(i, static_cast<int>(m.dist.size()) - 1, best);
       // Confidence from the plain distance differences, as for the other landmarks.
       double sq = 0;
-      for (int a = 0; a < na; ++a) sq += (m.dist[anchors[i][a]][best] - target[a]) * (m.dist[anchors[i][a]][best] - target[a]);
+      for (int a = 0; a < na; ++a) {
+        const double dd = m.dist[anchors[i][a]][best] - target[a];
+        sq += dd * dd;
+      }
       out.confidence[i].push_back(conf(i, std::sqrt(sq / na)));
     }
     for (int v = 0; v < nr; ++v) mind[v] = std::min(mind[v], rm.dist.back()[v]);

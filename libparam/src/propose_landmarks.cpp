@@ -788,6 +788,164 @@ std::vector<std::vector<int>> match_fine_peaks(const std::vector<Member>& mem, i
   return out;
 }
 
+// The finer peaks of an unstable extremity's region (a cat's ear tips) matched among
+// themselves, like the extremities (step 2 of propose_landmarks.h) but within the region.
+// Carried through sphere maps pinned only at the stable extremities, the head's peaks land
+// 0.1-0.2 sqrt(area) off (TOSCA cats: none came back to itself, the head was left without a
+// landmark). A region's peaks are the fine discs' maxima within twice extremity_radius of the
+// extremity the member's assignment gives (kRegionPeaks at most, by decreasing AGD, none
+// inside a stable landmark's tip region). An assignment (partial, injective) costs the
+// relative differences of its peaks' distances to the stable landmarks (which put them on the
+// head) and to each other (which tell an ear from the rest); a peak left out costs
+// kRegionMiss per term, half the cap: the head's other peaks (a broad snout or cheek peaking
+// 0.06-0.17 from the nose tip, at different places on different members) are left out
+// rather than matched at a distance factor beyond 1.2. Distances cannot tell the left ear from
+// the right, so among the kSphereCandidates cheapest within kSphereWindow, the turns of the
+// matched peaks and the stable landmarks, seen from the peaks' geodesic centre (between the
+// ears), decide, weighed against the cost as in the sphere test (kCostWeight). The maps'
+// orientation decided the shared cats alike; the turns need no map. Returns, per reference
+// peak matched on every member, its vertex on each.
+constexpr int kRegionPeaks = 6;
+constexpr double kRegionMiss = 0.5 * kPairCap;
+
+struct RegionPeaks {
+  std::vector<int> v;
+  std::vector<std::vector<double>> dist;
+};
+
+RegionPeaks region_peaks(const Member& m, int centre_field, const std::vector<int>& stable_fields,
+                         const ProposeLandmarksOptions& o) {
+  RegionPeaks r;
+  for (int p : m.fine) {
+    if (static_cast<int>(r.v.size()) >= kRegionPeaks) break;
+    if (!(m.dist[centre_field][p] <= 2 * o.extremity_radius)) continue;
+    bool free = true;
+    for (int f : stable_fields) free = free && m.dist[f][p] > o.extremity_radius;
+    if (!free) continue;
+    r.v.push_back(p);
+    r.dist.emplace_back();
+    dijkstra(m.g, p, r.dist.back());
+  }
+  return r;
+}
+
+// The vertex with the least sum of squared distances to the chosen peaks (with plain
+// distances, every vertex on the path between two peaks would tie, the peaks included).
+int geodesic_centre(const RegionPeaks& r, const std::vector<int>& chosen) {
+  const std::size_t n = r.dist.front().size();
+  int best = 0;
+  double best_s = kInf;
+  for (std::size_t v = 0; v < n; ++v) {
+    double s = 0;
+    for (int p : chosen) s += r.dist[p][v] * r.dist[p][v];
+    if (s < best_s) best_s = s, best = static_cast<int>(v);
+  }
+  return best;
+}
+
+std::vector<std::vector<int>> match_region_peaks(const std::vector<TriMesh>& meshes, const std::vector<Member>& mem,
+                                                 int ref, const MatchAll& ma, const ProposeLandmarksOptions& o,
+                                                 const std::vector<std::vector<int>>& anchors,
+                                                 const std::vector<std::vector<int>>& at) {
+  const int nm = static_cast<int>(mem.size());
+  const int na = static_cast<int>(anchors[ref].size());
+  auto rel = [](double a, double b) {
+    return std::min(std::abs(std::log((a + kRelativeSoftening) / (b + kRelativeSoftening))), kPairCap);
+  };
+  std::vector<std::vector<int>> out;
+  for (int q = 0; q < static_cast<int>(ma.unstable.size()); ++q) {
+    if (!ma.unstable[q]) continue;
+    bool everywhere = true;
+    for (int i = 0; i < nm; ++i) everywhere = everywhere && ma.to[i][q] >= 0;
+    if (!everywhere) continue;
+    std::vector<RegionPeaks> reg(nm);
+    for (int i = 0; i < nm; ++i) reg[i] = region_peaks(mem[i], ma.to[i][q], anchors[i], o);
+    const RegionPeaks& R = reg[ref];
+    const int kr = static_cast<int>(R.v.size());
+    if (kr == 0) continue;
+    const double terms = kr + kr * (kr - 1) / 2.0;
+    // The turns of the chosen peaks and the stable landmarks seen from the peaks' geodesic
+    // centre; triples of stable landmarks alone say nothing about the region and are left out.
+    auto turns = [&](int i, const RegionPeaks& P, const std::vector<int>& chosen) {
+      std::vector<int> pts;
+      for (int p : chosen) pts.push_back(P.v[p]);
+      const std::size_t peaks = pts.size();
+      pts.insert(pts.end(), at[i].begin(), at[i].end());
+      std::vector<double> t = triple_turns(meshes[i], mem[i], pts, geodesic_centre(P, chosen));
+      const std::size_t k = pts.size();
+      for (std::size_t a = 0; a < k; ++a)
+        for (std::size_t b = std::max(a + 1, peaks); b < k; ++b)
+          for (std::size_t c = b + 1; c < k; ++c) t[(a * k + b) * k + c] = 0;
+      return t;
+    };
+    std::vector<std::vector<int>> to(nm);  // per member: reference peak -> member peak or -1
+    to[ref].resize(kr);
+    std::iota(to[ref].begin(), to[ref].end(), 0);
+    for (int i = 0; i < nm; ++i) {
+      if (i == ref) continue;
+      const RegionPeaks& M = reg[i];
+      const int km = static_cast<int>(M.v.size());
+      std::vector<std::vector<double>> U(kr, std::vector<double>(km, 0.0));
+      for (int p = 0; p < kr; ++p)
+        for (int j = 0; j < km; ++j) {
+          for (int a = 0; a < na; ++a)
+            U[p][j] += rel(mem[i].dist[anchors[i][a]][M.v[j]], mem[ref].dist[anchors[ref][a]][R.v[p]]);
+          U[p][j] /= std::max(na, 1);
+        }
+      // Every partial injective assignment (at most kRegionPeaks points: 13327 of them).
+      std::vector<std::pair<double, std::vector<int>>> all;
+      std::vector<int> cur(kr, -1);
+      std::vector<char> used(km, 0);
+      auto recurse = [&](auto&& self, int p, double cost) -> void {
+        if (p == kr) {
+          all.emplace_back(cost / terms, cur);
+          return;
+        }
+        for (int j = -1; j < km; ++j) {
+          if (j >= 0 && used[j]) continue;
+          double add = j < 0 ? kRegionMiss : U[p][j];
+          for (int s = 0; s < p; ++s)
+            add += (j < 0 || cur[s] < 0) ? kRegionMiss : rel(M.dist[j][M.v[cur[s]]], R.dist[p][R.v[s]]);
+          cur[p] = j;
+          if (j >= 0) used[j] = 1;
+          self(self, p + 1, cost + add);
+          if (j >= 0) used[j] = 0;
+          cur[p] = -1;
+        }
+      };
+      recurse(recurse, 0, 0.0);
+      std::stable_sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      double best_score = -kInf;
+      for (std::size_t c = 0; c < all.size() && c < static_cast<std::size_t>(kSphereCandidates); ++c) {
+        const auto& [cost, a] = all[c];
+        if (cost > all.front().first + kSphereWindow) break;
+        std::vector<int> rc, mc;
+        for (int p = 0; p < kr; ++p)
+          if (a[p] >= 0) rc.push_back(p), mc.push_back(a[p]);
+        double proj = 0;
+        if (!rc.empty()) {
+          const std::vector<double> tr = turns(ref, R, rc), tm = turns(i, M, mc);
+          double norm = 0;
+          for (std::size_t x = 0; x < tr.size(); ++x) proj += tr[x] * tm[x], norm += tr[x] * tr[x];
+          proj = norm > 0 ? std::clamp(proj / norm, -1.0, 1.0) : 0.0;
+        }
+        const double score = proj - kCostWeight * (cost - all.front().first);
+        if (score > best_score) best_score = score, to[i] = a;
+      }
+    }
+    for (int p = 0; p < kr; ++p) {
+      std::vector<int> v(nm);
+      bool ok = true;
+      for (int i = 0; i < nm && ok; ++i) {
+        ok = to[i][p] >= 0;
+        if (ok) v[i] = reg[i].v[to[i][p]];
+      }
+      if (ok) out.push_back(std::move(v));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& meshes, const ProposeLandmarksOptions& o,
@@ -891,30 +1049,33 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   if (fine_stage)
     for (int i = 0; i < nm; ++i) locators.emplace_back(meshes[i].F, ma.maps[i]);
   const Carrier carry{meshes, ma.maps, locators};
-  if (fine_stage) {
-    for (const std::vector<int>& peak : match_fine_peaks(mem, ref, o, carry, anchors)) {
-      // Each moved to its (finer) tip region's centre; kept only where that is a vertex no
-      // landmark holds yet on any member (two features on one vertex cannot be mapped apart).
-      std::vector<int> v(nm);
-      bool free = true;
-      for (int i = 0; i < nm; ++i) {
-        Member& m = mem[i];
-        add_field(m, peak[i]);
-        v[i] = o.tip_drop > 0 ? tip_centre(meshes[i], m, peak[i], m.dist.back(), o.fine_radius, o.tip_drop) : peak[i];
-        free = free && std::find(at[i].begin(), at[i].end(), v[i]) == at[i].end();
-      }
-      if (!free) {
-        for (int i = 0; i < nm; ++i) mem[i].dist.pop_back(), mem[i].parent.pop_back();
-        continue;
-      }
-      for (int i = 0; i < nm; ++i) {
-        Member& m = mem[i];
-        if (v[i] != peak[i]) dijkstra(m.g, v[i], m.dist.back(), &m.parent.back());
-        add_landmark(i, static_cast<int>(m.dist.size()) - 1, v[i]);
-      }
-      ++out.fine_matched;
+  // A finer peak matched on every member, moved to its (finer) tip region's centre; kept only
+  // where that is a vertex no landmark holds yet on any member (two features on one vertex
+  // cannot be mapped apart).
+  auto add_peak = [&](const std::vector<int>& peak) {
+    std::vector<int> v(nm);
+    bool free = true;
+    for (int i = 0; i < nm; ++i) {
+      Member& m = mem[i];
+      add_field(m, peak[i]);
+      v[i] = o.tip_drop > 0 ? tip_centre(meshes[i], m, peak[i], m.dist.back(), o.fine_radius, o.tip_drop) : peak[i];
+      free = free && std::find(at[i].begin(), at[i].end(), v[i]) == at[i].end();
     }
-  }
+    if (!free) {
+      for (int i = 0; i < nm; ++i) mem[i].dist.pop_back(), mem[i].parent.pop_back();
+      return;
+    }
+    for (int i = 0; i < nm; ++i) {
+      Member& m = mem[i];
+      if (v[i] != peak[i]) dijkstra(m.g, v[i], m.dist.back(), &m.parent.back());
+      add_landmark(i, static_cast<int>(m.dist.size()) - 1, v[i]);
+    }
+    ++out.fine_matched;
+  };
+  if (o.fine_radius > 0)
+    for (const std::vector<int>& peak : match_region_peaks(meshes, mem, ref, ma, o, anchors, at)) add_peak(peak);
+  if (fine_stage)
+    for (const std::vector<int>& peak : match_fine_peaks(mem, ref, o, carry, anchors)) add_peak(peak);
   out.extremities = static_cast<int>(out.names.size());
 
   // Rim points of corresponding openings (detail/rim_landmarks.h), told apart by their

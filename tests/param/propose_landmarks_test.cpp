@@ -60,12 +60,12 @@ double mesh_area_for_test(const TriMesh& m) {
 // higher; `bend` (degrees) bends the body about the y axis, more towards its +x end (a pose).
 // Vertex v of every such blob is the same template point, so it is its own ground-truth
 // partner.
-TriMesh horned_blob(int taller, double bend) {
+TriMesh horned_blob(int taller, double bend, bool lopsided = false) {
   auto dir = [](double azimuth_deg, double elevation_deg) {
     const double a = azimuth_deg * std::numbers::pi / 180, e = elevation_deg * std::numbers::pi / 180;
     return Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
   };
-  const Eigen::Vector3d legs[4] = {dir(35, -35), dir(145, -35), dir(220, -35), dir(320, -35)};
+  const Eigen::Vector3d legs[4] = {dir(35, -35), dir(lopsided ? 165 : 145, -35), dir(220, -35), dir(lopsided ? 300 : 320, -35)};
   const Eigen::Vector3d head = dir(90, 25), horns[3] = {dir(59, 42), dir(121, 42), dir(90, 42)};
   const double height[3] = {taller == 0 ? 0.65 : 0.55, taller == 1 ? 0.65 : 0.55, 0.6};
   TriMesh m = test::icosphere(5);
@@ -173,6 +173,35 @@ TEST_CASE("propose_landmarks: an extremity whose peak changes horn is left out, 
   REQUIRE(old.ok());
   CHECK(old->unstable_dropped == 0);
   CHECK(old->fine_matched == 0);
+}
+
+TEST_CASE("propose_landmarks: an unstable extremity's horns matched among themselves, without sphere maps", "[param]") {
+  // The finer peaks of the unstable head are matched by their distances to the stable
+  // extremities and to each other, left and right by their turns: no sphere map is needed
+  // (before, they were only carried through maps, and with none the head was simply dropped).
+  std::vector<TriMesh> meshes = {horned_blob(0, 0, true), horned_blob(1, 25, true), horned_blob(0, -20, true),
+                                 horned_blob(1, 12, true)};
+  std::vector<int> perm;
+  meshes[2] = permuted(meshes[2], perm);
+  ProposeLandmarksOptions o;
+  o.reference = 0;
+  o.sphere_orientation = false;
+  auto r = propose_landmarks(meshes, o);
+  REQUIRE(r.ok());
+  INFO("extremities " << r->extremities << ", unstable left out " << r->unstable_dropped << ", finer peaks " << r->fine_matched);
+  CHECK(r->unstable_dropped >= 1);
+  CHECK(r->fine_matched >= 2);
+  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
+  int wrong = 0;
+  for (std::size_t i = 1; i < meshes.size(); ++i)
+    for (std::size_t k = 0; k < r->names.size(); ++k) {
+      int v = r->landmarks[0][k].vertex;
+      if (i == 2) v = perm[v];
+      const double err = (meshes[i].V.row(r->landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
+      UNSCOPED_INFO("member " << i << " " << r->names[k] << " error " << err);
+      wrong += err > 0.05;
+    }
+  CHECK(wrong == 0);
 }
 
 TEST_CASE("propose_landmarks: the ends and sides of corresponding openings, told apart by the extremities", "[param]") {

@@ -63,8 +63,9 @@ void register_landmarks(CLI::App& app) {
       "the one carrying the reference's shape best onto the member's wins: a left/right swap\n"
       "turns the body round; without sphere maps, or for meshes that are not genus 0, by the\n"
       "turns of matched triples), leaves out extremities whose peak is as high as another one beyond\n"
-      "the tip (a head peaking at the nose on one mesh and at an ear on another), adds the finer\n"
-      "peaks (--fine-radius) the sphere maps carry onto each other, optionally adds --extra-points\n"
+      "the tip (a head peaking at the nose on one mesh and at an ear on another) and matches that\n"
+      "region's finer peaks (--fine-radius: ear tips) among themselves instead, adds the finer\n"
+      "peaks elsewhere the sphere maps carry onto each other, optionally adds --extra-points\n"
       "further points (farthest-point sampling, located by their distances to the matched ones,\n"
       "front told from back by the turns of those seen from the point), and writes one\n"
       "`NAME.lm.txt` per mesh (beside it, or\n"
@@ -87,7 +88,7 @@ void register_landmarks(CLI::App& app) {
                   "move each extremity to the centre of its tip region: AGD within this of its peak (x sqrt(area); 0: the peak)")
       ->check(CLI::Range(0.0, 0.999));
   cmd->add_option("--fine-radius", o.fine_radius,
-                  "finer AGD peaks (this disc radius, x sqrt(area)) matched through the sphere maps; 0: off")
+                  "finer AGD peaks (this disc radius, x sqrt(area)): an unstable extremity's, and others through the sphere maps; 0: off")
       ->check(CLI::Range(0.0, 0.999));
   cmd->add_flag("--no-rim-points{false}", o.rim_points,
                 "no points on the rims of openings every mesh has (ends and side middles of eye and mouth holes)");

@@ -25,9 +25,12 @@
 // 4. Unstable extremities and finer peaks: an extremity with another peak beyond its tip
 //    region (up to twice `extremity_radius`) rising within `tip_drop` of it sits on different
 //    features on different members (a cat's head peaks at the nose on one and at an ear tip
-//    on another); it is left out, and the maps of the chosen assignments are made again with
-//    the stable ones. Then the AGD maxima of finer discs (`fine_radius`) outside every tip
-//    region are carried from the reference to each member through the sphere maps and
+//    on another); it is left out, and the finer peaks of its region (AGD maxima of discs of
+//    `fine_radius`: a cat's ear tips) are matched among themselves, like the extremities, by
+//    their distances to the stable ones and to each other, left and right by their turns
+//    (peaks that fit on no assignment, a broad snout's, are left out). The maps of the chosen
+//    assignments are made again with the stable ones pinned, and the finer peaks outside
+//    every tip region are carried from the reference to each member through them and
 //    snapped to the member's nearest such peak; those that snap on every member and snap
 //    back to themselves are added.
 // 5. Rim points: where the members have openings (boundary loops) that match by their
@@ -58,7 +61,7 @@ struct ProposeLandmarksOptions {
   int max_extremities = 10;      ///< at most this many extremities per member (3..16)
   double extremity_radius = 0.15;  ///< an extremity dominates the AGD on this geodesic disc (x sqrt(area))
   double tip_drop = 0.03;        ///< a matched extremity moves to the centre of its tip region: AGD within this of its own (x sqrt(area)); 0: stays at the AGD maximum
-  double fine_radius = 0.08;     ///< finer AGD maxima (this disc radius, x sqrt(area)) matched through the sphere maps; 0: off
+  double fine_radius = 0.08;     ///< finer AGD maxima (this disc radius, x sqrt(area)): an unstable extremity's matched among themselves, others through the sphere maps; 0: off
   bool rim_points = true;        ///< add points on the rims of openings every member has (eye and mouth corners)
   int extra_points = 0;          ///< further points by farthest-point sampling (>= 0)
   int reference = -1;            ///< the member the others are matched to; -1: the one of the first 8 matching the others best
@@ -85,7 +88,7 @@ struct ProposeLandmarksResult {
   int reference = 0;                            ///< the member the others were matched to
   int extremities = 0;                          ///< how many of `names` are extremities (including finer peaks)
   int unstable_dropped = 0;                     ///< extremities left out as unstable (another peak as high beyond the tip)
-  int fine_matched = 0;                         ///< finer AGD peaks matched through the sphere maps
+  int fine_matched = 0;                         ///< finer AGD peaks matched (unstable extremities' regions, then through the sphere maps)
   int rim_matched = 0;                          ///< points on the rims of corresponding openings (after the extremities)
   int rim_outliers_dropped = 0;                 ///< extremities left out: their distances to the rim points disagree (see the .cpp)
   std::vector<std::vector<Landmark>> landmarks; ///< per member, in the order of `names`

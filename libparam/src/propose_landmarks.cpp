@@ -788,25 +788,38 @@ std::vector<std::vector<int>> match_fine_peaks(const std::vector<Member>& mem, i
   return out;
 }
 
-// The finer peaks of an unstable extremity's region (a cat's ear tips) matched among
-// themselves, like the extremities (step 2 of propose_landmarks.h) but within the region.
-// Carried through sphere maps pinned only at the stable extremities, the head's peaks land
-// 0.1-0.2 sqrt(area) off (TOSCA cats: none came back to itself, the head was left without a
-// landmark). A region's peaks are the fine discs' maxima within twice extremity_radius of the
-// extremity the member's assignment gives (kRegionPeaks at most, by decreasing AGD, none
-// inside a stable landmark's tip region). An assignment (partial, injective) costs the
-// relative differences of its peaks' distances to the stable landmarks (which put them on the
-// head) and to each other (which tell an ear from the rest); a peak left out costs
-// kRegionMiss per term, half the cap: the head's other peaks (a broad snout or cheek peaking
-// 0.06-0.17 from the nose tip, at different places on different members) are left out
-// rather than matched at a distance factor beyond 1.2. Distances cannot tell the left ear from
-// the right, so among the kSphereCandidates cheapest within kSphereWindow, the turns of the
-// matched peaks and the stable landmarks, seen from the peaks' geodesic centre (between the
-// ears), decide, weighed against the cost as in the sphere test (kCostWeight). The maps'
-// orientation decided the shared cats alike; the turns need no map. Returns, per reference
-// peak matched on every member, its vertex on each.
+// The finer peaks of an extremity's region matched among themselves, like the extremities
+// (step 2 of propose_landmarks.h) but within the region. Two kinds of region:
+// - An unstable extremity's (a cat's head, peaking at the nose on one member and at an ear
+//   tip on another): the fine discs' maxima within twice extremity_radius of the extremity the
+//   member's assignment gives, none inside a stable landmark's tip region; every peak matched
+//   on all members is added (the cats' two ear tips). Carried through sphere maps pinned
+//   only at the stable extremities, they landed 0.1-0.2 sqrt(area) off (TOSCA cats: none came
+//   back to itself, the head was left without a landmark).
+// - A stable extremity's tip (a hand): the limb tips within extremity_radius of its landmark
+//   (see tip_peaks: a hand's fingertips); only the matched one farthest from the landmarks is
+//   added. One point off the limb's axis fixes the limb's twist about it, which the tip's
+//   centre alone leaves free (FAUST: arms turned by up to 0.16 sqrt(area) of correspondence
+//   error); that is the thumb, the most isolated fingertip. All four fingertips of each hand,
+//   each placed to 0.002-0.006, made `consistent` worse (0.077/0.085/0.051 against
+//   0.060/0.076/0.046 without any), the thumbs alone better (0.042/0.065/0.038).
+// An assignment (partial, injective) costs the relative differences of its peaks' distances
+// to the stable landmarks (which put them in the region) and to each other (which tell an
+// ear from the rest); a peak left out costs kRegionMiss per term, half the cap: the head's
+// other peaks (a broad snout or cheek peaking 0.06-0.17 from the nose tip, at different
+// places on different members) are left out rather than matched at a distance factor beyond
+// 1.2. Distances cannot tell the left ear from the right, so among the kSphereCandidates
+// cheapest within kSphereWindow, the turns of the matched peaks and the stable landmarks, seen
+// from the peaks' geodesic centre (between the ears), decide, weighed against the cost as in
+// the sphere test (kCostWeight). The maps' orientation decided the shared cats alike; the
+// turns need no map. Returns, per reference peak to add, its vertex on each member.
 constexpr int kRegionPeaks = 6;
 constexpr double kRegionMiss = 0.5 * kPairCap;
+// Limb tips (x sqrt(area)): an AGD maximum over a disc of kTipSeparation, that far from every
+// landmark, whose AGD falls by at least kTipSharpness times the distance in every direction
+// (measured kSharpRadius away): along a finger the AGD falls at about the rate of distance
+// (FAUST fingertips 0.56-0.77), on a bump it hardly falls (FAUST toes and heels: 0.00).
+constexpr double kTipSeparation = 0.02, kSharpRadius = 0.03, kTipSharpness = 0.3;
 
 struct RegionPeaks {
   std::vector<int> v;
@@ -825,6 +838,51 @@ RegionPeaks region_peaks(const Member& m, int centre_field, const std::vector<in
     r.v.push_back(p);
     r.dist.emplace_back();
     dijkstra(m.g, p, r.dist.back());
+  }
+  return r;
+}
+
+// How fast the AGD falls around v: (AGD(v) - the largest AGD between 0.75 r and 1.25 r from
+// v) / r; about 1 at a limb tip, 0 on a bump or a flat.
+double tip_sharpness(const Member& m, int v, double r) {
+  std::vector<double> d;
+  dijkstra(m.g, v, d, nullptr, 1.25 * r);
+  double top = -kInf;
+  for (std::size_t u = 0; u < d.size(); ++u)
+    if (d[u] >= 0.75 * r && d[u] <= 1.25 * r) top = std::max(top, m.agd[u]);
+  return top > -kInf ? (m.agd[v] - top) / r : 0.0;
+}
+
+// The limb tips (see kTipSharpness) within extremity_radius of a stable extremity's landmark
+// (field `centre_field`), by decreasing AGD, at most kRegionPeaks.
+RegionPeaks tip_peaks(const Member& m, int centre_field, const std::vector<int>& fields,
+                      const ProposeLandmarksOptions& o) {
+  RegionPeaks r;
+  const std::vector<double>& dc = m.dist[centre_field];
+  const int n = static_cast<int>(m.agd.size());
+  std::vector<int> cand;
+  for (int v = 0; v < n; ++v) {
+    if (!(dc[v] <= o.extremity_radius)) continue;
+    bool top = true;
+    for (int k = m.g.start[v]; k < m.g.start[v + 1] && top; ++k) top = m.agd[m.g.nbr[k]] <= m.agd[v];
+    if (top) cand.push_back(v);
+  }
+  std::sort(cand.begin(), cand.end(), [&](int a, int b) { return m.agd[a] != m.agd[b] ? m.agd[a] > m.agd[b] : a < b; });
+  std::vector<double> d;
+  for (int v : cand) {
+    if (static_cast<int>(r.v.size()) >= kRegionPeaks) break;
+    bool free = true;
+    for (int f : fields) free = free && m.dist[f][v] > kTipSeparation;
+    for (const std::vector<double>& pd : r.dist) free = free && pd[v] > kTipSeparation;
+    if (!free) continue;
+    dijkstra(m.g, v, d, nullptr, kTipSeparation);
+    bool top = true;
+    for (int u = 0; u < n && top; ++u)
+      if (d[u] <= kTipSeparation) top = m.agd[u] <= m.agd[v];
+    if (!top || tip_sharpness(m, v, kSharpRadius) < kTipSharpness) continue;
+    r.v.push_back(v);
+    r.dist.emplace_back();
+    dijkstra(m.g, v, r.dist.back());
   }
   return r;
 }
@@ -853,13 +911,15 @@ std::vector<std::vector<int>> match_region_peaks(const std::vector<TriMesh>& mes
     return std::min(std::abs(std::log((a + kRelativeSoftening) / (b + kRelativeSoftening))), kPairCap);
   };
   std::vector<std::vector<int>> out;
-  for (int q = 0; q < static_cast<int>(ma.unstable.size()); ++q) {
-    if (!ma.unstable[q]) continue;
+  const int kr_all = static_cast<int>(ma.to[ref].size());
+  for (int q = 0; q < kr_all; ++q) {
     bool everywhere = true;
     for (int i = 0; i < nm; ++i) everywhere = everywhere && ma.to[i][q] >= 0;
     if (!everywhere) continue;
+    const bool unstable = q < static_cast<int>(ma.unstable.size()) && ma.unstable[q];
     std::vector<RegionPeaks> reg(nm);
-    for (int i = 0; i < nm; ++i) reg[i] = region_peaks(mem[i], ma.to[i][q], anchors[i], o);
+    for (int i = 0; i < nm; ++i)
+      reg[i] = unstable ? region_peaks(mem[i], ma.to[i][q], anchors[i], o) : tip_peaks(mem[i], ma.to[i][q], anchors[i], o);
     const RegionPeaks& R = reg[ref];
     const int kr = static_cast<int>(R.v.size());
     if (kr == 0) continue;
@@ -933,6 +993,8 @@ std::vector<std::vector<int>> match_region_peaks(const std::vector<TriMesh>& mes
         if (score > best_score) best_score = score, to[i] = a;
       }
     }
+    std::vector<int> farthest;  // a stable extremity's: the tip farthest from the landmarks
+    double farthest_d = -1;
     for (int p = 0; p < kr; ++p) {
       std::vector<int> v(nm);
       bool ok = true;
@@ -940,8 +1002,16 @@ std::vector<std::vector<int>> match_region_peaks(const std::vector<TriMesh>& mes
         ok = to[i][p] >= 0;
         if (ok) v[i] = reg[i].v[to[i][p]];
       }
-      if (ok) out.push_back(std::move(v));
+      if (!ok) continue;
+      if (unstable) {
+        out.push_back(std::move(v));
+        continue;
+      }
+      double d = kInf;
+      for (int f : anchors[ref]) d = std::min(d, mem[ref].dist[f][R.v[p]]);
+      if (d > farthest_d) farthest_d = d, farthest = std::move(v);
     }
+    if (!farthest.empty()) out.push_back(std::move(farthest));
   }
   return out;
 }
@@ -1049,26 +1119,16 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   if (fine_stage)
     for (int i = 0; i < nm; ++i) locators.emplace_back(meshes[i].F, ma.maps[i]);
   const Carrier carry{meshes, ma.maps, locators};
-  // A finer peak matched on every member, moved to its (finer) tip region's centre; kept only
-  // where that is a vertex no landmark holds yet on any member (two features on one vertex
-  // cannot be mapped apart).
+  // A finer peak matched on every member, kept only where it is a vertex no landmark holds yet
+  // on any member (two features on one vertex cannot be mapped apart). It stays where it
+  // is: moved to the centre of its tip region (AGD within tip_drop inside fine_radius), a
+  // fingertip was drawn towards the hand's middle.
   auto add_peak = [&](const std::vector<int>& peak) {
-    std::vector<int> v(nm);
-    bool free = true;
+    for (int i = 0; i < nm; ++i)
+      if (std::find(at[i].begin(), at[i].end(), peak[i]) != at[i].end()) return;
     for (int i = 0; i < nm; ++i) {
-      Member& m = mem[i];
-      add_field(m, peak[i]);
-      v[i] = o.tip_drop > 0 ? tip_centre(meshes[i], m, peak[i], m.dist.back(), o.fine_radius, o.tip_drop) : peak[i];
-      free = free && std::find(at[i].begin(), at[i].end(), v[i]) == at[i].end();
-    }
-    if (!free) {
-      for (int i = 0; i < nm; ++i) mem[i].dist.pop_back(), mem[i].parent.pop_back();
-      return;
-    }
-    for (int i = 0; i < nm; ++i) {
-      Member& m = mem[i];
-      if (v[i] != peak[i]) dijkstra(m.g, v[i], m.dist.back(), &m.parent.back());
-      add_landmark(i, static_cast<int>(m.dist.size()) - 1, v[i]);
+      add_field(mem[i], peak[i]);
+      add_landmark(i, static_cast<int>(mem[i].dist.size()) - 1, peak[i]);
     }
     ++out.fine_matched;
   };

@@ -57,10 +57,11 @@ double mesh_area_for_test(const TriMesh& m) {
 
 // A blob with four legs at uneven azimuths and a head crest of three horns in a row (an ear,
 // a crest, an ear), the outer two of nearly the same height: `taller` says which of them is
-// higher; `bend` (degrees) bends the body about the y axis, more towards its +x end (a pose).
+// higher; `thumb`: a spike out of the side of the first leg near its tip; `bend` (degrees)
+// bends the body about the y axis, more towards its +x end (a pose).
 // Vertex v of every such blob is the same template point, so it is its own ground-truth
 // partner.
-TriMesh horned_blob(int taller, double bend, bool lopsided = false) {
+TriMesh horned_blob(int taller, double bend, bool lopsided = false, bool thumb = false) {
   auto dir = [](double azimuth_deg, double elevation_deg) {
     const double a = azimuth_deg * std::numbers::pi / 180, e = elevation_deg * std::numbers::pi / 180;
     return Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
@@ -75,7 +76,27 @@ TriMesh horned_blob(int taller, double bend, bool lopsided = false) {
     for (const auto& d : legs) s += 1.6 * std::pow(std::max(0.0, p.dot(d)), 16);
     s += 0.6 * std::pow(std::max(0.0, p.dot(head)), 6);
     for (int h = 0; h < 3; ++h) s += height[h] * std::pow(std::max(0.0, p.dot(horns[h])), 80);
-    const Eigen::Vector3d x = p * s;
+    m.V.row(v) = p * s;
+  }
+  if (thumb) {  // pushed out along the normal of the leg's side near its tip: a sideways spike
+    const Eigen::Vector3d side = dir(41, -29);
+    Eigen::Index base = 0;
+    for (Eigen::Index v = 1; v < m.V.rows(); ++v)
+      if (m.V.row(v).normalized().dot(side) > m.V.row(base).normalized().dot(side)) base = v;
+    Eigen::Vector3d n = Eigen::Vector3d::Zero();
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c)
+        if (m.F(f, c) == base)
+          n += (m.V.row(m.F(f, 1)) - m.V.row(m.F(f, 0))).cross(m.V.row(m.F(f, 2)) - m.V.row(m.F(f, 0))).transpose();
+    n.normalize();
+    const Eigen::Vector3d b = m.V.row(base).transpose();
+    for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+      const double d = (m.V.row(v).transpose() - b).norm() / 0.25;
+      if (d < 1) m.V.row(v) += 0.5 * (1 - d * d) * (1 - d * d) * n.transpose();
+    }
+  }
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+    const Eigen::Vector3d x = m.V.row(v).transpose();
     const double t = bend * std::numbers::pi / 180 * (x.x() + 3) / 6;
     m.V.row(v) = Eigen::Vector3d(std::cos(t) * x.x() + std::sin(t) * x.z(), x.y(), -std::sin(t) * x.x() + std::cos(t) * x.z());
   }
@@ -202,6 +223,37 @@ TEST_CASE("propose_landmarks: an unstable extremity's horns matched among themse
       wrong += err > 0.05;
     }
   CHECK(wrong == 0);
+}
+
+TEST_CASE("propose_landmarks: a stable extremity's most isolated tip is added (a limb's twist)", "[param]") {
+  // A leg with a thumb: the leg's tip is its extremity on every member, the thumb a limb tip
+  // of its own within the leg's tip region; it is added, on every member.
+  std::vector<TriMesh> meshes = {horned_blob(0, 0, false, true), horned_blob(1, 25, false, true),
+                                 horned_blob(0, -20, false, true), horned_blob(1, 12, false, true)};
+  std::vector<int> perm;
+  meshes[1] = permuted(meshes[1], perm);
+  ProposeLandmarksOptions o;
+  o.reference = 0;
+  auto r = propose_landmarks(meshes, o);
+  REQUIRE(r.ok());
+  INFO("extremities " << r->extremities << ", unstable left out " << r->unstable_dropped << ", finer peaks " << r->fine_matched);
+  CHECK(r->fine_matched >= 3);  // the outer horns of the unstable head, and the thumb
+  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
+  int wrong = 0;
+  for (std::size_t i = 1; i < meshes.size(); ++i)
+    for (std::size_t k = 0; k < r->names.size(); ++k) {
+      int v = r->landmarks[0][k].vertex;
+      if (i == 1) v = perm[v];
+      const double err = (meshes[i].V.row(r->landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
+      UNSCOPED_INFO("member " << i << " " << r->names[k] << " error " << err);
+      wrong += err > 0.05;
+    }
+  CHECK(wrong == 0);
+  // Without the thumb, one landmark fewer.
+  meshes = {horned_blob(0, 0), horned_blob(1, 25), horned_blob(0, -20), horned_blob(1, 12)};
+  auto off = propose_landmarks(meshes, o);
+  REQUIRE(off.ok());
+  CHECK(off->names.size() < r->names.size());
 }
 
 TEST_CASE("propose_landmarks: the ends and sides of corresponding openings, told apart by the extremities", "[param]") {

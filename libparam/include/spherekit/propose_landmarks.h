@@ -28,7 +28,11 @@
 //    on another); it is left out, and the finer peaks of its region (AGD maxima of discs of
 //    `fine_radius`: a cat's ear tips) are matched among themselves, like the extremities, by
 //    their distances to the stable ones and to each other, left and right by their turns
-//    (peaks that fit on no assignment, a broad snout's, are left out). The maps of the chosen
+//    (peaks that fit on no assignment, a broad snout's, are left out). A stable extremity's
+//    tip region may hold limb tips of its own (a hand's fingertips: AGD maxima where the AGD
+//    falls at least 0.3 times as fast as the distance); they are matched the same way and
+//    the one farthest from the landmarks (the thumb) is added: it fixes the limb's twist,
+//    which the tip's centre alone leaves free. The maps of the chosen
 //    assignments are made again with the stable ones pinned, and the finer peaks outside
 //    every tip region are carried from the reference to each member through them and
 //    snapped to the member's nearest such peak; those that snap on every member and snap

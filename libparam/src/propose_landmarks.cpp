@@ -678,10 +678,12 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
       ma.total += pick.a.cost / pairs - mm.cost;
       mm.cost = pick.a.cost / pairs;
       mm.orientation_agreement = pick.turn;
-      // The cheapest assignment needs a turned-round body: if it is clearly cheaper than the
-      // pick, the member is a mirror image (intrinsically best only reflected); if not, the
-      // shape is (nearly) symmetric and its left/right was settled by the sphere test.
-      mm.mirrored = pick.a.cost - cands.front().a.cost > kClose * pairs;
+      // If the cheapest assignment turns the other way from the pick (a turned-round body) and
+      // is clearly cheaper, the member is a mirror image (intrinsically best only reflected);
+      // if not, the shape is (nearly) symmetric and its left/right was settled by the sphere
+      // test. A cheapest assignment turning the same way is simply another match the test
+      // ruled out (TOSCA cat2 was called mirrored for one).
+      mm.mirrored = pick.a.cost - cands.front().a.cost > kClose * pairs && (cands.front().turn < 0) != (pick.turn < 0);
       ma.to[i] = pick.a.to;
     };
     if (scored.empty() || scored.front().first <= -2) continue;  // no map: the choice by turns stands

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <queue>
@@ -158,14 +159,15 @@ void add_field(Member& m, int v) {
 
 // Local maxima of the AGD, by decreasing AGD: 1-ring maxima kept when no vertex of their
 // geodesic disc of `radius` has a larger AGD and no kept one lies in it (one point per limb
-// tip, not one per bump); at most `max_count`.
-std::vector<int> agd_peaks(const Member& m, double radius, int max_count) {
+// tip, not one per bump); at most `max_count`, only those `accept` takes (if given).
+std::vector<int> agd_peaks(const Member& m, double radius, int max_count,
+                           const std::function<bool(int)>& accept = nullptr) {
   const int n = static_cast<int>(m.agd.size());
   std::vector<int> cand, out;
   for (int v = 0; v < n; ++v) {
     bool top = true;
     for (int i = m.g.start[v]; i < m.g.start[v + 1] && top; ++i) top = m.agd[m.g.nbr[i]] <= m.agd[v];
-    if (top) cand.push_back(v);
+    if (top && (!accept || accept(v))) cand.push_back(v);
   }
   std::sort(cand.begin(), cand.end(), [&](int a, int b) { return m.agd[a] != m.agd[b] ? m.agd[a] > m.agd[b] : a < b; });
   std::vector<double> d;
@@ -859,29 +861,15 @@ double tip_sharpness(const Member& m, int v, double r) {
 // (field `centre_field`), by decreasing AGD, at most kRegionPeaks.
 RegionPeaks tip_peaks(const Member& m, int centre_field, const std::vector<int>& fields,
                       const ProposeLandmarksOptions& o) {
-  RegionPeaks r;
   const std::vector<double>& dc = m.dist[centre_field];
-  const int n = static_cast<int>(m.agd.size());
-  std::vector<int> cand;
-  for (int v = 0; v < n; ++v) {
-    if (!(dc[v] <= o.extremity_radius)) continue;
-    bool top = true;
-    for (int k = m.g.start[v]; k < m.g.start[v + 1] && top; ++k) top = m.agd[m.g.nbr[k]] <= m.agd[v];
-    if (top) cand.push_back(v);
-  }
-  std::sort(cand.begin(), cand.end(), [&](int a, int b) { return m.agd[a] != m.agd[b] ? m.agd[a] > m.agd[b] : a < b; });
-  std::vector<double> d;
-  for (int v : cand) {
-    if (static_cast<int>(r.v.size()) >= kRegionPeaks) break;
-    bool free = true;
-    for (int f : fields) free = free && m.dist[f][v] > kTipSeparation;
-    for (const std::vector<double>& pd : r.dist) free = free && pd[v] > kTipSeparation;
-    if (!free) continue;
-    dijkstra(m.g, v, d, nullptr, kTipSeparation);
-    bool top = true;
-    for (int u = 0; u < n && top; ++u)
-      if (d[u] <= kTipSeparation) top = m.agd[u] <= m.agd[v];
-    if (!top || tip_sharpness(m, v, kSharpRadius) < kTipSharpness) continue;
+  auto is_tip = [&](int v) {
+    if (!(dc[v] <= o.extremity_radius)) return false;
+    for (int f : fields)
+      if (!(m.dist[f][v] > kTipSeparation)) return false;
+    return tip_sharpness(m, v, kSharpRadius) >= kTipSharpness;
+  };
+  RegionPeaks r;
+  for (int v : agd_peaks(m, kTipSeparation, kRegionPeaks, is_tip)) {
     r.v.push_back(v);
     r.dist.emplace_back();
     dijkstra(m.g, v, r.dist.back());

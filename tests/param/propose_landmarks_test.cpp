@@ -55,6 +55,23 @@ double mesh_area_for_test(const TriMesh& m) {
   return a;
 }
 
+// Landmarks more than 0.05 sqrt(area) from their ground-truth partner on members 1.. of blobs
+// whose vertex v is the same template point (member `renumbered` by `perm`).
+int misplaced_on_blobs(const std::vector<TriMesh>& meshes, const ProposeLandmarksResult& r, std::size_t renumbered,
+                       const std::vector<int>& perm) {
+  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
+  int wrong = 0;
+  for (std::size_t i = 1; i < meshes.size(); ++i)
+    for (std::size_t k = 0; k < r.names.size(); ++k) {
+      int v = r.landmarks[0][k].vertex;  // the ground-truth partner: the same template vertex
+      if (i == renumbered) v = perm[v];
+      const double err = (meshes[i].V.row(r.landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
+      UNSCOPED_INFO("member " << i << " " << r.names[k] << " error " << err);
+      wrong += err > 0.05;
+    }
+  return wrong;
+}
+
 // A blob with four legs at uneven azimuths and a head crest of three horns in a row (an ear,
 // a crest, an ear), the outer two of nearly the same height: `taller` says which of them is
 // higher; `thumb`: a spike out of the side of the first leg near its tip; `bend` (degrees)
@@ -177,17 +194,7 @@ TEST_CASE("propose_landmarks: an extremity whose peak changes horn is left out, 
   CHECK(r->unstable_dropped >= 1);
   CHECK(r->fine_matched >= 2);  // at least the two outer horns, each on its own
   REQUIRE(r->extremities >= 6);
-  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
-  int wrong = 0;
-  for (std::size_t i = 1; i < meshes.size(); ++i)
-    for (std::size_t k = 0; k < r->names.size(); ++k) {
-      int v = r->landmarks[0][k].vertex;  // the ground-truth partner: the same template vertex
-      if (i == 3) v = perm[v];
-      const double err = (meshes[i].V.row(r->landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
-      UNSCOPED_INFO("member " << i << " " << r->names[k] << " error " << err);
-      wrong += err > 0.05;
-    }
-  CHECK(wrong == 0);
+  CHECK(misplaced_on_blobs(meshes, *r, 3, perm) == 0);
   // Without the finer stage the head is proposed as one point, and is wrong somewhere.
   o.fine_radius = 0;
   auto old = propose_landmarks(meshes, o);
@@ -212,17 +219,7 @@ TEST_CASE("propose_landmarks: an unstable extremity's horns matched among themse
   INFO("extremities " << r->extremities << ", unstable left out " << r->unstable_dropped << ", finer peaks " << r->fine_matched);
   CHECK(r->unstable_dropped >= 1);
   CHECK(r->fine_matched >= 2);
-  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
-  int wrong = 0;
-  for (std::size_t i = 1; i < meshes.size(); ++i)
-    for (std::size_t k = 0; k < r->names.size(); ++k) {
-      int v = r->landmarks[0][k].vertex;
-      if (i == 2) v = perm[v];
-      const double err = (meshes[i].V.row(r->landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
-      UNSCOPED_INFO("member " << i << " " << r->names[k] << " error " << err);
-      wrong += err > 0.05;
-    }
-  CHECK(wrong == 0);
+  CHECK(misplaced_on_blobs(meshes, *r, 2, perm) == 0);
 }
 
 TEST_CASE("propose_landmarks: a stable extremity's most isolated tip is added (a limb's twist)", "[param]") {
@@ -238,17 +235,7 @@ TEST_CASE("propose_landmarks: a stable extremity's most isolated tip is added (a
   REQUIRE(r.ok());
   INFO("extremities " << r->extremities << ", unstable left out " << r->unstable_dropped << ", finer peaks " << r->fine_matched);
   CHECK(r->fine_matched >= 3);  // the outer horns of the unstable head, and the thumb
-  const double sa = std::sqrt(mesh_area_for_test(meshes[0]));
-  int wrong = 0;
-  for (std::size_t i = 1; i < meshes.size(); ++i)
-    for (std::size_t k = 0; k < r->names.size(); ++k) {
-      int v = r->landmarks[0][k].vertex;
-      if (i == 1) v = perm[v];
-      const double err = (meshes[i].V.row(r->landmarks[i][k].vertex) - meshes[i].V.row(v)).norm() / sa;
-      UNSCOPED_INFO("member " << i << " " << r->names[k] << " error " << err);
-      wrong += err > 0.05;
-    }
-  CHECK(wrong == 0);
+  CHECK(misplaced_on_blobs(meshes, *r, 1, perm) == 0);
   // Without the thumb, one landmark fewer.
   meshes = {horned_blob(0, 0), horned_blob(1, 25), horned_blob(0, -20), horned_blob(1, 12)};
   auto off = propose_landmarks(meshes, o);

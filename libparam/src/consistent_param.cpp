@@ -15,6 +15,7 @@
 #include "detail/rotation.h"
 #include "detail/sphere_embedding.h"
 #include "detail/stage_util.h"
+#include "spherekit/fill_holes.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/metrics.h"
 #include "spherekit/progressive_mesh.h"
@@ -192,7 +193,28 @@ Status replace_refined_map(const TriMesh& mesh, const std::vector<int>& feature_
                            const std::vector<Eigen::Vector3d>& locations, RowMat3d S, ConstrainedParamResult* map) {
   if (locations.size() != feature_vertices.size())
     return Status(ErrorCode::InvalidArgument, "need one location per feature vertex");
-  SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics mm, evaluate_sphere_map(mesh, S));
+  // Measured as the constrained stage measures (constrained_param.cpp): on the mesh with its
+  // holes closed by fans and normalized, stretch over the input's own faces only. On the open
+  // mesh the winding is undefined (evaluate_sphere_map reports 0), and a refined member with
+  // holes was reported with winding 0 beside its step-6 map's +1. Each fan's centre goes to
+  // the normalized mean of its loop's sphere points: inside the hole's small region, so the
+  // closed map's signed area is 4 pi times its degree.
+  SPHEREKIT_ASSIGN_OR_RETURN(const FilledMesh filled, fill_holes(mesh));
+  const detail::Normalization nz = detail::bounding_box_normalization(filled.mesh.V);
+  if (!(nz.diagonal > 0)) return Status(ErrorCode::InvalidInput, "mesh has zero extent");
+  TriMesh unit;
+  unit.V = (filled.mesh.V.rowwise() - nz.centre) / nz.diagonal;
+  unit.F = filled.mesh.F;
+  RowMat3d S_closed(filled.mesh.V.rows(), 3);
+  S_closed.topRows(S.rows()) = S;
+  for (size_t h = 0; h < filled.loops.size(); ++h) {
+    Eigen::RowVector3d c = Eigen::RowVector3d::Zero();
+    for (int v : filled.loops[h]) c += S.row(v);
+    S_closed.row(filled.original_vertices + static_cast<Eigen::Index>(h)) = c.normalized();
+  }
+  std::vector<char> real(static_cast<size_t>(filled.mesh.F.rows()), 0);
+  for (int f = 0; f < filled.original_faces; ++f) real[static_cast<size_t>(f)] = 1;
+  SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics mm, evaluate_sphere_map(unit, S_closed, {}, &real));
   map->map.S = std::move(S);
   map->flipped_faces = count_flipped_faces(mesh.F, map->map.S);
   map->efficiency = mm.efficiency;

@@ -11,7 +11,9 @@
 #include "sample_collection.h"
 #include "spherekit/consistent_param.h"
 #include "spherekit/correspondence.h"
+#include "spherekit/metrics.h"
 #include "spherekit/sphere_param.h"
+#include "test_meshes.h"
 
 using namespace spherekit;
 using samples::SampleMesh;
@@ -202,6 +204,29 @@ TEST_CASE("the correspondence refinement brings the members closer to the refere
     CHECK(after < before);
   }
   CHECK(taken >= 1);
+}
+
+TEST_CASE("a refined map of a mesh with holes is measured with its holes closed: winding +1",
+          "[param][consistent]") {
+  // The refinement's maps are measured again by replace_refined_map. On the open mesh the
+  // winding is undefined and was reported as 0 for every refined member with holes (the
+  // ICT heads), beside +1 for the same map before the refinement.
+  const TriMesh open = test::sphere_with_holes(2, 3);
+  RowMat3d S = open.V.rowwise().normalized();  // the icosphere's own bijective map
+  REQUIRE(count_flipped_faces(open.F, S) == 0);
+  auto on_open = evaluate_sphere_map(open, S);
+  REQUIRE(on_open.ok());
+  CHECK(on_open->winding == 0.0);  // the metric's convention for open meshes
+  ConstrainedParamResult map;
+  const std::vector<int> fv{0, 5};
+  const std::vector<Eigen::Vector3d> at{S.row(0).transpose(), S.row(5).transpose()};
+  REQUIRE(replace_refined_map(open, fv, at, S, &map).ok());
+  CHECK(map.winding == Approx(1.0).margin(1e-9));
+  CHECK(map.flipped_faces == 0);
+  CHECK(map.max_feature_angle == 0.0);
+  // Stretch over the input's own faces: the same as measured on the open mesh.
+  CHECK(map.efficiency == Approx(on_open->efficiency).epsilon(1e-9));
+  CHECK(map.map.S == S);
 }
 
 TEST_CASE("consistent maps are the same bits for any thread count", "[param][consistent]") {

@@ -11,11 +11,13 @@
 #include <Eigen/SparseCholesky>
 #include <set>
 
+#include "detail/collapsed_map.h"
 #include "detail/parallel_jobs.h"
 #include "detail/rotation.h"
 #include "detail/sphere_embedding.h"
 #include "detail/stage_util.h"
 #include "spherekit/fill_holes.h"
+#include "spherekit/format_text.h"
 #include "spherekit/geometry_image.h"
 #include "spherekit/metrics.h"
 #include "spherekit/progressive_mesh.h"
@@ -27,6 +29,10 @@ namespace {
 using detail::seconds_since;
 
 std::string mesh_label(int i) { return "mesh " + std::to_string(i); }
+
+// Step 6 "collapsed" for a mesh whose map to F keeps less than this fraction of its step-2
+// map's stretch efficiency (normal members keep 0.96-1.01x: ICT heads, FAUST, TOSCA cats).
+constexpr double kStepSixCollapse = 0.7;
 
 // Forwards a callee's progress with the step named in front ("step 5: refine").
 ProgressFn prefixed(const ProgressFn& progress, const std::string& step) {
@@ -412,7 +418,25 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   MeshFailure failure6;
   const Status s6 = constrained_maps(meshes, features, all, result.final_locations, options, "step 6", progress,
                                      &final_maps, &failure6);
-  if (s6.ok()) {
+  // A step-6 map can also complete and still be poor: where F moves features so that a
+  // member's network must wind round (ICT heads with the nose tip and chin added to proposed
+  // landmarks: one head's longest path 2.4x its shortest route, efficiency 0.43 against 0.80
+  // for its step-2 map, and the refinement cannot undo it: correspondence error 0.14 against
+  // 0.008-0.018 for the others). Such a map is a failure of the locations F for that member
+  // (other Steiner costs gave 0.45-0.47), treated like a map that could not be made.
+  const int collapsed = s6.ok() ? detail::first_collapsed_map(final_maps, result.maps, kStepSixCollapse) : -1;
+  if (s6.ok() && collapsed >= 0) {
+    const auto& a = final_maps[static_cast<size_t>(collapsed)];
+    const auto& b = result.maps[static_cast<size_t>(collapsed)];
+    result.refinement_failure_mesh = collapsed;
+    result.refinement_failure_reason =
+        "its map to F has stretch efficiency " + format_text("%.3f", a.efficiency) + ", below " +
+        format_text("%.2f", kStepSixCollapse) + "x its step-2 map's " + format_text("%.3f", b.efficiency) +
+        " (longest network path " + format_text("%.2f", a.network.max_ratio) + "x its shortest route)";
+    result.refinement_failure = mesh_label(collapsed) + ": " + result.refinement_failure_reason;
+    result.rejected_locations = result.final_locations;
+    result.final_locations = result.initial_locations;
+  } else if (s6.ok()) {
     result.maps = std::move(final_maps);
   } else if (s6.code() == ErrorCode::SolverFailed) {
     // One mesh cannot be mapped to F: the step-2 maps are a complete, consistent answer (all

@@ -7,6 +7,7 @@
 
 #include <Eigen/SVD>
 
+#include "detail/collapsed_map.h"
 #include "map_checks.h"
 #include "sample_collection.h"
 #include "spherekit/consistent_param.h"
@@ -227,6 +228,22 @@ TEST_CASE("a refined map of a mesh with holes is measured with its holes closed:
   // Stretch over the input's own faces: the same as measured on the open mesh.
   CHECK(map.efficiency == Approx(on_open->efficiency).epsilon(1e-9));
   CHECK(map.map.S == S);
+}
+
+TEST_CASE("a step-6 map that keeps too little of its step-2 efficiency is found", "[param][consistent]") {
+  auto maps = [](std::vector<double> eff) {
+    std::vector<ConstrainedParamResult> m(eff.size());
+    for (size_t i = 0; i < eff.size(); ++i) m[i].efficiency = eff[i];
+    return m;
+  };
+  // The ICT heads of the fallback's comment: 0.799/0.432/0.770/0.806 to F, 0.819/0.796/
+  // 0.795/0.837 to F'; the second collapsed (0.54x), the others kept 0.96-0.98x.
+  const auto step2 = maps({0.819, 0.796, 0.795, 0.837});
+  CHECK(detail::first_collapsed_map(maps({0.799, 0.432, 0.770, 0.806}), step2, 0.7) == 1);
+  CHECK(detail::first_collapsed_map(maps({0.799, 0.760, 0.770, 0.806}), step2, 0.7) == -1);
+  // The first of several, and the boundary itself is not a collapse.
+  CHECK(detail::first_collapsed_map(maps({0.799, 0.760, 0.3, 0.2}), step2, 0.7) == 2);
+  CHECK(detail::first_collapsed_map(maps({0.5, 0.5, 0.5, 0.5}), maps({0.5, 0.5, 0.5, 0.5}), 1.0) == -1);
 }
 
 TEST_CASE("consistent maps are the same bits for any thread count", "[param][consistent]") {

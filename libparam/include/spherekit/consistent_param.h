@@ -73,7 +73,8 @@ struct ConsistentParamResult {
   int joint_flips = 0;              ///< step 5 map's flipped faces (exact predicate; 0)
   int remesh_vertices = 0;          ///< vertices of the joint mesh (0 if not run)
   /// Non-empty when step 6 failed for some mesh (a constrained map to F could not be
-  /// completed, e.g. its path network's Steiner vertices could not be removed): the result
+  /// completed, e.g. its path network's Steiner vertices could not be removed, or it was
+  /// completed keeping less than 0.7x its step-2 map's stretch efficiency): the result
   /// then falls back to the step-2 maps (every feature on F', still consistent) and this
   /// holds the reason; `rejected_locations` holds the F that was tried.
   std::string refinement_failure;

@@ -1123,14 +1123,13 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
     ++out.fine_matched;
   };
   // Peaks matched within a region (by distances and turns only) are the least sure landmarks:
-  // the openings below are matched without them (`region_matched` marks them).
-  std::vector<char> region_matched(out.names.size(), 0);
+  // the openings below are matched without them (landmarks region_begin .. region_end - 1).
+  const std::size_t region_begin = out.names.size();
   if (o.fine_radius > 0)
     for (const std::vector<int>& peak : match_region_peaks(meshes, mem, ref, ma, o, anchors, at)) add_peak(peak);
-  region_matched.resize(out.names.size(), 1);
+  const std::size_t region_end = out.names.size();
   if (fine_stage)
     for (const std::vector<int>& peak : match_fine_peaks(mem, ref, o, carry, anchors)) add_peak(peak);
-  region_matched.resize(out.names.size(), 0);
   out.extremities = static_cast<int>(out.names.size());
 
   // Rim points of corresponding openings (detail/rim_landmarks.h), told apart by their
@@ -1150,7 +1149,7 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
       std::vector<std::vector<const std::vector<double>*>> fields(nm);
       for (int i = 0; i < nm; ++i)
         for (std::size_t k = 0; k < anchors[i].size(); ++k)
-          if (k >= region_matched.size() || !region_matched[k]) fields[i].push_back(&mem[i].dist[anchors[i][k]]);
+          if (k < region_begin || k >= region_end) fields[i].push_back(&mem[i].dist[anchors[i][k]]);
       const std::vector<detail::RimPoint> rim = matcher.match(fields, ref);
       for (const detail::RimPoint& pt : rim) {
         for (int i = 0; i < nm; ++i) {

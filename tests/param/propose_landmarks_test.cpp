@@ -9,10 +9,10 @@
 #include <random>
 #include <vector>
 
+#include "dense_landmarks.h"
 #include "detail/landmark_orientation.h"
 #include "sample_collection.h"
 #include "spherekit/propose_landmarks.h"
-#include "dense_landmarks.h"
 #include "test_meshes.h"
 #include "test_paths.h"
 #include "test_skip.h"
@@ -538,9 +538,7 @@ TEST_CASE("shared ICT heads with decimated members: the openings are matched by 
   CHECK(r->rim_matched >= 4);
   // Each member's landmark, as its template point on head_s1, against the reference's.
   const TriMesh& t = meshes[0];
-  double area = 0;
-  for (Eigen::Index f = 0; f < t.F.rows(); ++f)
-    area += 0.5 * (t.V.row(t.F(f, 1)) - t.V.row(t.F(f, 0))).cross(t.V.row(t.F(f, 2)) - t.V.row(t.F(f, 0))).norm();
+  const double area = mesh_area_for_test(t);
   int pairs = 0, within = 0;
   for (std::size_t i = 1; i < meshes.size(); ++i)
     for (std::size_t k = 0; k < r->names.size(); ++k) {

@@ -210,6 +210,9 @@ int remove_steiner_vertices(const detail::PathNetwork& net, const std::vector<ch
 
 namespace {
 constexpr const char* kSteinerFailure = "a face stays flipped after removing the path network's Steiner vertices";
+// Vertex optimizations per free vertex after which a pass of this stage counts as not
+// converging (normal maps: at most about 31; OptimizerSettings::max_pass_work).
+constexpr double kConstrainedPassWork = 100;
 
 // `steiner_failure` is set when the attempt failed only because a face stayed flipped after
 // the Steiner vertices were removed: the one failure another network variant may avoid.
@@ -428,6 +431,10 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   t0 = std::chrono::steady_clock::now();
   detail::OptimizerSettings settings = detail::optimizer_settings(so);
   settings.edge_frame_cruft = false;  // the collection stages' energy (stretch_optimizer.cpp, singular_cruft_term)
+  // Targets that force a poor map (a network winding round between features) can keep the
+  // optimizer busy for many minutes at every level; such a map fails here, deterministically,
+  // and the collection's step 6 falls back to its step-2 maps (OptimizerSettings::max_pass_work).
+  settings.max_pass_work = kConstrainedPassWork;
   std::vector<double> wnet(static_cast<size_t>(nnf), 1.0), snet(static_cast<size_t>(nnf), 0.0);
   for (int f = 0; f < nnf; ++f)
     if (net.face_origin[static_cast<size_t>(f)] >= filled.original_faces) {

@@ -380,10 +380,16 @@ class Refiner {
     st_.update_areas();
     for (int g = 0; g < s.global_iter; ++g) {
       std::uint64_t pass_key = s_.seed * 0xd1b54a32d192ed03ULL + static_cast<std::uint64_t>(stats_->passes) * 0x8cb92ba72f3d8dd7ULL;
+      bool exceeded = false;
       int rounds = optimize_all(
           st_, s, pass_key, [&] { return report_progress(progress_, "optimize", st_.alive_vertices, -1.0); },
-          &pool_);
+          &pool_, &exceeded);
       if (rounds < 0) return Status(ErrorCode::Cancelled, "cancelled during optimization");
+      if (exceeded)
+        return Status(ErrorCode::SolverFailed,
+                      "the stretch optimization did not converge (a pass over " + std::to_string(st_.alive_vertices) +
+                          " vertices needed more than " + std::to_string(static_cast<int>(s.max_pass_work)) +
+                          " moves per vertex; normal maps need at most about 30)");
       ++stats_->passes;
       stats_->rounds += rounds;
     }

@@ -690,7 +690,7 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
 }
 
 int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
-                 const std::function<bool()>& keep_going, WorkerPool* pool) {
+                 const std::function<bool()>& keep_going, WorkerPool* pool, bool* work_exceeded) {
   const int nv = static_cast<int>(st.S.rows());
   auto is_fixed = [&](int v) { return !st.fixed.empty() && st.fixed[static_cast<size_t>(v)]; };
   std::vector<double> credit(static_cast<size_t>(nv), 0.0);
@@ -765,9 +765,22 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       c.moved = true;
     }
   };
+  // The work budget counts the vertex optimizations of the rounds (the active vertices), which
+  // do not depend on the thread count: the pass ends at the same round for any count.
+  const double work_budget =
+      s.max_pass_work > 0
+          ? s.max_pass_work * static_cast<double>(std::max<size_t>(active.size(), kMinPassWorkVertices))
+          : 0.0;
+  double work = 0;
+  if (work_exceeded) *work_exceeded = false;
   int round = 0;
   for (; round < s.max_rounds && !active.empty(); ++round) {
     if (keep_going && !keep_going()) return -1;
+    work += static_cast<double>(active.size());
+    if (work_budget > 0 && work > work_budget) {
+      if (work_exceeded) *work_exceeded = true;
+      break;
+    }
     if (s.coloured_rounds) {
       // Colour the active vertices greedily (by id, smallest colour unused by an already
       // coloured active neighbour), then run the colour classes one after another: a class

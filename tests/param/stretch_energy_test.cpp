@@ -1,11 +1,14 @@
 // White-box checks of the stretch optimizer's per-vertex energy (libparam/src/stretch_optimizer.cpp):
-// independence of face numbering and the size of the anti-cruft term (issue 20).
+// independence of face numbering and the size of the anti-cruft term (issue 20); a pass's work bound.
 #include <catch2/catch.hpp>
 
 #include <Eigen/SVD>
 #include <cmath>
 
+#include "detail/sphere_embedding.h"
 #include "detail/sphere_state.h"
+#include "detail/worker_pool.h"
+#include "spherekit/metrics.h"
 #include "spherekit/predicates.h"
 #include "test_meshes.h"
 
@@ -259,4 +262,57 @@ TEST_CASE("a ring read through the pass's ring index is the ring read from the f
     ++compared;
   }
   CHECK(compared == static_cast<int>(S.rows()) - 1);
+}
+
+TEST_CASE("a pass over its work bound ends early, at the same round for any thread count, and fails the stage",
+          "[param][sphere][energy]") {
+  // A capsule 4x as long as wide, its vertices projected radially onto the sphere: a valid
+  // map far from the stretch optimum, so a pass has many rounds of work.
+  const TriMesh m = test::elongated(3, 4.0);
+  RowMat3d S0 = m.V;
+  S0.rowwise().normalize();
+  REQUIRE(count_flipped_faces(m.F, S0) == 0);
+  const RowMatXd P = m.V;
+  OptimizerSettings s = settings_for_effort(2);
+  auto run_pass = [&](double max_work, int threads, bool* exceeded, RowMat3d* out) {
+    SphereState st = make_state(m, S0, P);
+    s.max_pass_work = max_work;
+    WorkerPool pool(threads);
+    const int rounds = optimize_all(st, s, 7, {}, &pool, exceeded);
+    *out = st.S;
+    return rounds;
+  };
+  bool unbounded_flag = true, bounded_flag = false, bounded_flag2 = false, loose_flag = true;
+  RowMat3d S_unbounded, S_bounded, S_bounded2, S_loose;
+  const int full = run_pass(0, 1, &unbounded_flag, &S_unbounded);
+  // Budget: 1 optimization per vertex of max(#V, 500): the first round (all vertices) fits,
+  // the second does not.
+  const int cut = run_pass(1, 1, &bounded_flag, &S_bounded);
+  const int cut2 = run_pass(1, 2, &bounded_flag2, &S_bounded2);
+  const int loose = run_pass(100, 2, &loose_flag, &S_loose);
+  CHECK_FALSE(unbounded_flag);
+  CHECK(full > 2);
+  CHECK(bounded_flag);
+  CHECK(cut == 1);
+  CHECK(bounded_flag2);
+  CHECK(cut2 == cut);
+  CHECK(S_bounded2 == S_bounded);
+  CHECK(count_flipped_faces(m.F, S_bounded) == 0);
+  // A bound the pass does not reach changes nothing.
+  CHECK_FALSE(loose_flag);
+  CHECK(loose == full);
+  CHECK(S_loose == S_unbounded);
+
+  // Through a stage: the pass over its bound is a SolverFailed that says why.
+  const std::vector<char> fixed(static_cast<size_t>(m.V.rows()), 0);
+  const std::vector<double> w(static_cast<size_t>(m.F.rows()), 1.0), sw(static_cast<size_t>(m.F.rows()), 0.0);
+  s.max_pass_work = 1;
+  RowMat3d S = S0;
+  const Status failed = optimize_in_place(P, m.F, w, sw, fixed, s, {}, &S);
+  CHECK(failed.code() == ErrorCode::SolverFailed);
+  CHECK(failed.message().find("did not converge") != std::string::npos);
+  s.max_pass_work = 100;
+  S = S0;
+  CHECK(optimize_in_place(P, m.F, w, sw, fixed, s, {}, &S).ok());
+  CHECK(count_flipped_faces(m.F, S) == 0);
 }

@@ -69,6 +69,14 @@ struct OptimizerSettings {
   std::uint64_t seed = 1;
   int threads = 0;             ///< 0 = hardware concurrency
   int max_rounds = 2000;       ///< safety cap on rounds per pass
+  /// If > 0: a pass that needs more than this many vertex optimizations per free vertex (at
+  /// least kMinPassWorkVertices vertices' worth) is not converging, and the stage fails
+  /// (SolverFailed) instead of going on. Measured on normal inputs (unconstrained maps of the
+  /// generated limb shapes, FAUST and ICT collections): at most 31 per vertex on passes over
+  /// 200 vertices; the constrained stage sets 100. A step-6 map of ICT heads whose features
+  /// were left out (no head top, no neck corners) needed 230-520 per vertex on every pass
+  /// from 700 vertices on, and had not finished after 11 CPU minutes.
+  double max_pass_work = 0;
   bool coloured_rounds = false;  ///< rounds as colour classes (every computed move applied) instead of one greedy independent set
   bool edge_frame_cruft = true;  ///< SphereState::edge_frame_cruft for this stage (the collection stages set false)
 };
@@ -151,7 +159,14 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
 /// greedily as an independent set (largest first). Deterministic for any thread count.
 /// Returns the number of rounds, or -1 if cancelled by `keep_going`. `pool` runs the
 /// candidate moves (null: on the calling thread only).
+/// With s.max_pass_work > 0, a pass that exceeds that work ends early and sets
+/// *work_exceeded (if given).
 int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
-                 const std::function<bool()>& keep_going, WorkerPool* pool = nullptr);
+                 const std::function<bool()>& keep_going, WorkerPool* pool = nullptr,
+                 bool* work_exceeded = nullptr);
+
+/// The floor of OptimizerSettings::max_pass_work's budget, in vertices: coarse levels of a
+/// few dozen vertices take up to 100 optimizations per vertex on normal inputs (FAUST, 33).
+inline constexpr int kMinPassWorkVertices = 500;
 
 }  // namespace spherekit::detail

@@ -34,6 +34,11 @@ std::string mesh_label(int i) { return "mesh " + std::to_string(i); }
 // map's stretch efficiency (detail/collapsed_map.h: normal maps keep 0.96-1.01x, a reference
 // 0.80 in the non-isometric pair bunny + gargoyle).
 constexpr double kStepSixCollapse = 0.7;
+// Step 6 "wound" for a mesh whose network to F has a path more than kStepSixWinding times its
+// shortest route, and kStepSixWindingGrowth times its step-2 network's longest (normal
+// networks: at most 1.25x; detail/collapsed_map.h).
+constexpr double kStepSixWinding = 2.0;
+constexpr double kStepSixWindingGrowth = 1.5;
 
 // Forwards a callee's progress with the step named in front ("step 5: refine").
 ProgressFn prefixed(const ProgressFn& progress, const std::string& step) {
@@ -426,15 +431,22 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   // 0.008-0.018 for the others). Such a map is a failure of the locations F for that member
   // (other Steiner costs gave 0.45-0.47), treated like a map that could not be made.
   const int collapsed = s6.ok() ? detail::first_collapsed_map(final_maps, result.maps, kStepSixCollapse) : -1;
-  if (s6.ok() && collapsed >= 0) {
-    const auto& a = final_maps[static_cast<size_t>(collapsed)];
-    const auto& b = result.maps[static_cast<size_t>(collapsed)];
-    result.refinement_failure_mesh = collapsed;
+  const int wound = s6.ok() && collapsed < 0
+                        ? detail::first_wound_map(final_maps, result.maps, kStepSixWinding, kStepSixWindingGrowth)
+                        : -1;
+  if (s6.ok() && (collapsed >= 0 || wound >= 0)) {
+    const int bad = collapsed >= 0 ? collapsed : wound;
+    const auto& a = final_maps[static_cast<size_t>(bad)];
+    const auto& b = result.maps[static_cast<size_t>(bad)];
+    result.refinement_failure_mesh = bad;
     result.refinement_failure_reason =
-        "its map to F has stretch efficiency " + format_text("%.3f", a.efficiency) + ", below " +
-        format_text("%.2f", kStepSixCollapse) + "x its step-2 map's " + format_text("%.3f", b.efficiency) +
-        " (longest network path " + format_text("%.2f", a.network.max_ratio) + "x its shortest route)";
-    result.refinement_failure = mesh_label(collapsed) + ": " + result.refinement_failure_reason;
+        collapsed >= 0
+            ? "its map to F has stretch efficiency " + format_text("%.3f", a.efficiency) + ", below " +
+                  format_text("%.2f", kStepSixCollapse) + "x its step-2 map's " + format_text("%.3f", b.efficiency) +
+                  " (longest network path " + format_text("%.2f", a.network.max_ratio) + "x its shortest route)"
+            : "its network to F winds round: a path " + format_text("%.2f", a.network.max_ratio) +
+                  "x its shortest route (to F' " + format_text("%.2f", b.network.max_ratio) + "x)";
+    result.refinement_failure = mesh_label(bad) + ": " + result.refinement_failure_reason;
     result.rejected_locations = result.final_locations;
     result.final_locations = result.initial_locations;
   } else if (s6.ok()) {

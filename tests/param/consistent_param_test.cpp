@@ -246,6 +246,24 @@ TEST_CASE("a step-6 map that keeps too little of its step-2 efficiency is found"
   CHECK(detail::first_collapsed_map(maps({0.5, 0.5, 0.5, 0.5}), maps({0.5, 0.5, 0.5, 0.5}), 1.0) == -1);
 }
 
+TEST_CASE("a step-6 network that winds round where its step-2 network did not is found", "[param][consistent]") {
+  auto maps = [](std::vector<double> ratio) {
+    std::vector<ConstrainedParamResult> m(ratio.size());
+    for (size_t i = 0; i < ratio.size(); ++i) m[i].network.max_ratio = ratio[i];
+    return m;
+  };
+  // The ICT heads of collapsed_map.h: longest paths 1.17/1.21/2.76/2.47 to F, the reference's
+  // step-2 map unconstrained (no network), the others 1.17/1.18/1.22 to F'.
+  const auto step2 = maps({0.0, 1.17, 1.18, 1.22});
+  CHECK(detail::first_wound_map(maps({1.17, 1.21, 2.76, 2.47}), step2, 2.0, 1.5) == 2);
+  // Normal networks (at most 1.25x), and a mesh that wound as much to F' (no gain in falling back).
+  CHECK(detail::first_wound_map(maps({1.05, 1.10, 1.13, 1.25}), step2, 2.0, 1.5) == -1);
+  CHECK(detail::first_wound_map(maps({1.05, 1.10, 1.13, 2.5}), maps({0.0, 1.1, 1.1, 2.2}), 2.0, 1.5) == -1);
+  // The reference (no step-2 network) by the limit alone; the limit itself is not winding.
+  CHECK(detail::first_wound_map(maps({2.1, 1.0, 1.0, 1.0}), step2, 2.0, 1.5) == 0);
+  CHECK(detail::first_wound_map(maps({2.0, 1.0, 1.0, 1.0}), step2, 2.0, 1.5) == -1);
+}
+
 TEST_CASE("consistent maps are the same bits for any thread count", "[param][consistent]") {
   const auto& c = small_collection();
   std::vector<TriMesh> meshes;

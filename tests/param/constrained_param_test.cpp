@@ -141,6 +141,32 @@ TEST_CASE("targets crowded into one hemisphere are completed with auxiliary feat
   require_on_targets(r->map.S, fv, t);
 }
 
+TEST_CASE("two meshes mapped to the same one-sided targets get the same auxiliary targets", "[param][constrained]") {
+  // A collection's steps 2 and 6 map every member to the same targets: their auxiliary
+  // features must sit at the same sphere points, or the members' path networks differ
+  // (before: each mesh's own farthest vertex, at its own point).
+  std::vector<Eigen::Vector3d> dirs = {{0, 0, 1}, {0.5, 0, 0.8}, {-0.5, 0, 0.8}, {0, 0.5, 0.8}, {0, -0.5, 0.8}};
+  for (auto& d : dirs) d.normalize();
+  const std::vector<Eigen::Vector3d> t = dirs;
+  REQUIRE_FALSE(detail::targets_surround_origin(t));
+  std::vector<std::vector<Eigen::Vector3d>> aux;
+  for (std::uint64_t seed : {3, 8}) {
+    const TriMesh m = test::random_blob(3, seed);
+    const std::vector<int> fv = pick_features(m, dirs);
+    auto r = parameterize_sphere_constrained(m, fv, t);
+    REQUIRE(r.ok());
+    require_valid_map(m, r->map.S);
+    require_on_targets(r->map.S, fv, t);
+    REQUIRE(r->network.auxiliary_features > 0);
+    REQUIRE(r->network.arc_targets.size() == t.size() + static_cast<size_t>(r->network.auxiliary_features));
+    aux.emplace_back(r->network.arc_targets.begin() + static_cast<std::ptrdiff_t>(t.size()), r->network.arc_targets.end());
+    // Every auxiliary target is on the far side from the given ones.
+    for (const auto& a : aux.back())
+      for (const auto& d : dirs) CHECK(a.dot(d) < 0.5);
+  }
+  CHECK(aux[0] == aux[1]);
+}
+
 TEST_CASE("path network and arc network have the same rotation system", "[param][constrained][network]") {
   TriMesh m = test::random_blob(3, 21);
   std::vector<Eigen::Vector3d> dirs = octahedron_dirs();

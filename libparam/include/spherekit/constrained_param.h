@@ -71,8 +71,12 @@ struct ConstrainedParamResult {
 /// feature_vertices[i] lands on targets[i].
 /// 0 features: the unconstrained map. 1 feature: the unconstrained map rotated onto the
 /// target. 2-3 features, or targets all on one side of the sphere: auxiliary features are
-/// added where the rotated unconstrained map puts far-away vertices, so that the features
-/// triangulate the sphere; they are reported in network.auxiliary_features.
+/// added so that the features triangulate the sphere: each at the point of a fixed lattice
+/// farthest from the targets so far (so meshes mapped to the same targets get the same
+/// auxiliary targets, and networks of the same layout), on the vertex the rotated
+/// unconstrained map puts nearest to it; reported in network.auxiliary_features.
+/// SolverFailed also when a stretch pass does not converge (more than 100 vertex moves per
+/// vertex; normal maps need at most about 31).
 /// @return the map, or InvalidArgument (sizes, targets not unit vectors), InvalidInput (mesh
 ///         not genus 0, two features on one vertex, targets closer than 1e-7 rad),
 ///         SolverFailed (the path network could not be completed), Cancelled.

@@ -1,4 +1,5 @@
-// Telling a step-6 map that completed but collapsed from one that merely moved its features
+// Telling a step-6 map that completed but collapsed (or wound its network round) from one that
+// merely moved its features
 // (Asirvatham, Praun, Hoppe 2005 §3, step 6).
 #pragma once
 
@@ -21,6 +22,24 @@ inline int first_collapsed_map(const std::vector<ConstrainedParamResult>& to_fin
                                const std::vector<ConstrainedParamResult>& to_initial, double fraction) {
   for (size_t i = 0; i < to_final.size() && i < to_initial.size(); ++i)
     if (to_final[i].efficiency < fraction * to_initial[i].efficiency) return static_cast<int>(i);
+  return -1;
+}
+
+/// A step-6 map can keep its stretch and still be wrong: where F turns a mesh's network so
+/// that a path winds round (a path more than twice its shortest route), the regions between
+/// the paths no longer match the other meshes'. Normal networks (ICT heads, FAUST, TOSCA cats,
+/// given or proposed landmarks, steps 2 and 6) have no path above 1.25x; ICT heads with the
+/// landmarks on the face and the head's top had step-6 paths of 2.47x and 2.76x (1.18x and
+/// 1.22x to F') at 0.94-0.96x their step-2 efficiency, and correspondence errors of
+/// 0.045-0.058 against 0.008-0.015 with the step-2 maps. Returns the first mesh whose
+/// longest path to F is above `limit` and above `growth` times its longest path to F' (a
+/// mesh that winds as much to F' gains nothing from falling back), or -1.
+inline int first_wound_map(const std::vector<ConstrainedParamResult>& to_final,
+                           const std::vector<ConstrainedParamResult>& to_initial, double limit, double growth) {
+  for (size_t i = 0; i < to_final.size() && i < to_initial.size(); ++i) {
+    const double r = to_final[i].network.max_ratio;
+    if (r > limit && r > growth * to_initial[i].network.max_ratio) return static_cast<int>(i);
+  }
   return -1;
 }
 

@@ -219,6 +219,8 @@ constexpr const char* kSteinerFailure = "a face stays flipped after removing the
 Eigen::Vector3d farthest_lattice_point(const std::vector<Eigen::Vector3d>& targets) {
   constexpr int kPoints = 4096;
   const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+  std::vector<Eigen::Vector3d> unit;  // normalized once, not per lattice point
+  for (const auto& t : targets) unit.push_back(t.normalized());
   Eigen::Vector3d best = Eigen::Vector3d::UnitZ();
   double best_cos = kInf;  // the largest dot product with a target, minimized
   for (int i = 0; i < kPoints; ++i) {
@@ -226,7 +228,7 @@ Eigen::Vector3d farthest_lattice_point(const std::vector<Eigen::Vector3d>& targe
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
     const Eigen::Vector3d p(r * std::cos(golden * i), r * std::sin(golden * i), z);
     double c = -kInf;
-    for (const auto& t : targets) c = std::max(c, p.dot(t.normalized()));
+    for (const auto& t : unit) c = std::max(c, p.dot(t));
     if (c < best_cos) {
       best_cos = c;
       best = p;

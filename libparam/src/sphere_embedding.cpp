@@ -389,7 +389,7 @@ class Refiner {
         return Status(ErrorCode::SolverFailed,
                       "the stretch optimization did not converge (a pass over " + std::to_string(st_.alive_vertices) +
                           " vertices needed more than " + std::to_string(static_cast<int>(s.max_pass_work)) +
-                          " moves per vertex; normal maps need at most about 30)");
+                          " moves per vertex; normal maps need at most about 31)");
       ++stats_->passes;
       stats_->rounds += rounds;
     }

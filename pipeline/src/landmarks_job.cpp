@@ -57,6 +57,7 @@ Json to_json(const LandmarksJob& job, const LandmarksResult& r) {
   j["names"] = p.names;
   j["extremities"] = p.extremities;
   j["unstable_dropped"] = p.unstable_dropped;
+  j["mismatch_dropped"] = p.mismatch_dropped;
   j["fine_matched"] = p.fine_matched;
   j["rim_matched"] = p.rim_matched;
   j["rim_outliers_dropped"] = p.rim_outliers_dropped;

@@ -36,6 +36,9 @@ int run_landmarks(const LandmarksArgs& a) {
   if (p.unstable_dropped > 0 || p.fine_matched > 0)
     std::printf("  %d unstable extremities left out (another peak as high beyond the tip), %d finer peaks matched\n",
                 p.unstable_dropped, p.fine_matched);
+  if (p.mismatch_dropped > 0)
+    std::printf("  %d extremities left out: matched to another feature on some mesh (most of their distances wrong there)\n",
+                p.mismatch_dropped);
   if (p.rim_matched > 0)
     std::printf("  %d points on the rims of corresponding openings; %d extremities left out (their distances to them disagree)\n",
                 p.rim_matched, p.rim_outliers_dropped);

@@ -18,7 +18,10 @@
 //    only be realised by turning the body round, face onto the back of the head.
 //    Where no sphere map can be made (not genus 0), the orientation of triples of matched
 //    points seen from a trilaterated centre decides. Members where neither decides are
-//    flagged `mirror_ambiguous` (never guessed silently).
+//    flagged `mirror_ambiguous` (never guessed silently). A signal that carries no shape at
+//    all (a flat figure) decides nothing: the turns do.
+//    An extremity whose distances on some member are wrong far beyond that member's other
+//    extremities' (matched to another feature: a tail that is no extremity there) is left out.
 //    Each matched extremity then moves to the centre of its tip region (the AGD within
 //    `tip_drop` of its maximum): a hand's nearly equal fingertip peaks trade places between
 //    poses, the centre of the hand's tip does not.
@@ -92,6 +95,7 @@ struct ProposeLandmarksResult {
   int reference = 0;                            ///< the member the others were matched to
   int extremities = 0;                          ///< how many of `names` are extremities (including finer peaks)
   int unstable_dropped = 0;                     ///< extremities left out as unstable (another peak as high beyond the tip)
+  int mismatch_dropped = 0;                     ///< extremities left out: matched to another feature on some member (most of its distances wrong there)
   int fine_matched = 0;                         ///< finer AGD peaks matched (unstable extremities' regions, then through the sphere maps)
   int rim_matched = 0;                          ///< points on the rims of corresponding openings (after the extremities)
   int rim_outliers_dropped = 0;                 ///< extremities left out: their distances to the rim points disagree (see the .cpp)

@@ -1412,4 +1412,82 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
   return out;
 }
 
+Result<std::vector<SuspectLandmark>> suspect_landmarks(const std::vector<TriMesh>& meshes,
+                                                       const std::vector<std::vector<int>>& landmarks, int reference) {
+  using R = Result<std::vector<SuspectLandmark>>;
+  const int nm = static_cast<int>(meshes.size());
+  if (landmarks.size() != meshes.size()) return R(ErrorCode::InvalidArgument, "suspect_landmarks: one landmark list per mesh");
+  if (reference < 0 || reference >= nm) return R(ErrorCode::InvalidArgument, "suspect_landmarks: reference out of range");
+  const std::size_t k = landmarks[static_cast<std::size_t>(reference)].size();
+  std::vector<SuspectLandmark> out;
+  // Dense sets (more than kMaxChecked) are left unchecked: the leave-one-out medians cost k^3
+  // per member and round, and such sets come from tools, not from hands.
+  constexpr std::size_t kMaxChecked = 64;
+  if (k < 4 || k > kMaxChecked) return out;
+  // Per member: the distances between its landmarks (k x k, sqrt(area) units).
+  std::vector<std::vector<double>> D(static_cast<std::size_t>(nm));
+  for (int i = 0; i < nm; ++i) {
+    const std::vector<int>& lm = landmarks[static_cast<std::size_t>(i)];
+    if (lm.size() != k) return R(ErrorCode::InvalidArgument, "mesh " + std::to_string(i) + ": a different number of landmarks");
+    auto g = build_graph(meshes[static_cast<std::size_t>(i)], i);
+    if (!g.ok()) return g.status();
+    for (int v : lm)
+      if (v < 0 || v >= static_cast<int>(meshes[static_cast<std::size_t>(i)].V.rows()))
+        return R(ErrorCode::InvalidInput, "mesh " + std::to_string(i) + ": landmark vertex " + std::to_string(v) + " out of range");
+    std::vector<double>& Di = D[static_cast<std::size_t>(i)];
+    Di.assign(k * k, kInf);
+    std::vector<double> d;
+    for (std::size_t a = 0; a < k; ++a) {
+      dijkstra(*g, lm[a], d);
+      for (std::size_t b = 0; b < k; ++b) Di[a * k + b] = d[static_cast<std::size_t>(lm[b])];
+    }
+  }
+  auto median = [](std::vector<double> v) {
+    auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  // Per member, worst first while more than 3 remain: a landmark whose pairs disagree far beyond
+  // the pairs among the others. Leaving the landmark itself out of the comparison matters: two
+  // names swapped spoil 13 of a cat's 28 pairs (the median of all pairs 0.17 where the right
+  // members have 0.035), and the swapped tail, 0.78, was then only 4.7 times that.
+  const std::vector<double>& Dr = D[static_cast<std::size_t>(reference)];
+  for (int i = 0; i < nm; ++i) {
+    if (i == reference) continue;
+    const std::vector<double>& Dm = D[static_cast<std::size_t>(i)];
+    // |log ratio| per pair; NaN where either member has them apart (separate components).
+    std::vector<double> E(k * k, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t a = 0; a < k; ++a)
+      for (std::size_t b = 0; b < k; ++b)
+        if (a != b && std::isfinite(Dr[a * k + b]) && std::isfinite(Dm[a * k + b]))
+          E[a * k + b] = std::abs(std::log(std::max(Dr[a * k + b], 1e-9) / std::max(Dm[a * k + b], 1e-9)));
+    std::vector<std::size_t> keep(k);
+    std::iota(keep.begin(), keep.end(), std::size_t{0});
+    while (keep.size() > 3) {
+      std::size_t worst = k;
+      double worst_per = 0, worst_typical = 0;
+      for (std::size_t a : keep) {
+        std::vector<double> row, others;
+        for (std::size_t b : keep) {
+          if (b == a) continue;
+          if (!std::isnan(E[a * k + b])) row.push_back(E[a * k + b]);
+          for (std::size_t c : keep)
+            if (c > b && c != a && !std::isnan(E[b * k + c])) others.push_back(E[b * k + c]);
+        }
+        if (row.empty() || others.empty()) continue;
+        const double per = median(std::move(row)), typical = median(std::move(others));
+        // The floor is the matching's cap (a factor 1.5: a pair simply wrong), not the
+        // proposal's 0.2: a user's file is only questioned where the landmark is clearly
+        // elsewhere (a warped gargoyle's right landmark differed by 1.25 against 1.04).
+        if (per > kPairCap && per > kMismatchFactor * typical && per > worst_per)
+          worst = a, worst_per = per, worst_typical = typical;
+      }
+      if (worst == k) break;
+      out.push_back({i, static_cast<int>(worst), worst_per, worst_typical});
+      keep.erase(std::find(keep.begin(), keep.end(), worst));
+    }
+  }
+  return out;
+}
+
 }  // namespace spherekit

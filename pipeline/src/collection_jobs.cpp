@@ -17,6 +17,7 @@
 #include "spherekit/formats/mesh_io.h"
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/metrics.h"
+#include "spherekit/propose_landmarks.h"
 #include "spherekit/pipeline/collection.h"
 #include "spherekit/pipeline/collection_update.h"
 #include "spherekit/pipeline/json.h"
@@ -319,6 +320,18 @@ Result<MakeCollectionResult> make_collection(const MakeCollectionJob& a, const P
     meshes.push_back(m.mesh);
     features.push_back(m.feature_vertices);
   }
+  // Given landmark files are taken as they are, but a landmark on another feature on some
+  // member (a wrong index, two names swapped in one file) twists that member's map without any
+  // error: it is reported (the rule that leaves such an extremity out of a proposal).
+  if (auto suspects = suspect_landmarks(meshes, features, out.reference); suspects.ok())
+    for (const SuspectLandmark& x : *suspects)
+      out.landmark_warnings.push_back(format_text(
+          "%s (%s): landmark '%s' is not where %s's is: its distances to the others differ by a factor %.2f "
+          "(the member's other landmarks: %.2f); misplaced, or on another feature?",
+          out.members[static_cast<size_t>(x.member)].name.c_str(),
+          out.members[static_cast<size_t>(x.member)].features_file.c_str(),
+          out.feature_names[static_cast<size_t>(x.landmark)].c_str(),
+          out.members[static_cast<size_t>(out.reference)].name.c_str(), std::exp(x.disagreement), std::exp(x.typical)));
   MeshFailure failure;
   auto result = parameterize_consistent(meshes, features, o, progress, &failure);
   if (!result.ok()) {

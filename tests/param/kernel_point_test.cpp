@@ -74,7 +74,7 @@ double lattice_max_min(const Ring& r) {
 
 }  // namespace
 
-TEST_CASE("kernel_point: a ring with room in its kernel always gets a point in it; an empty one costs the full ascent",
+TEST_CASE("kernel_point: a ring with room in its kernel always gets a point in it, an empty one costs the full ascent",
           "[kernel_point]") {
   std::mt19937 rng(5);
   int roomy = 0, empty = 0;

@@ -593,3 +593,56 @@ TEST_CASE("shared ICT heads with decimated members: the openings are matched by 
     }
   CHECK(within >= 0.9 * pairs);
 }
+
+TEST_CASE("suspect_landmarks: a given file's swapped names are reported, right files pass", "[param]") {
+  samples::SampleCollectionOptions so;
+  so.members = 4;
+  so.target_vertices = 2000;
+  auto c = samples::make_sample_collection(so);
+  REQUIRE(c.ok());
+  std::vector<TriMesh> meshes;
+  std::vector<std::vector<int>> lm;
+  for (const auto& m : *c) {
+    meshes.push_back(m.mesh);
+    lm.emplace_back();
+    for (const Landmark& l : m.landmarks) lm.back().push_back(l.vertex);
+  }
+  const std::size_t k = lm[0].size();
+  REQUIRE(k >= 6);
+  // The built-in members in their different proportions and poses: nothing reported, for any
+  // reference.
+  for (int ref = 0; ref < 4; ++ref) {
+    auto r = suspect_landmarks(meshes, lm, ref);
+    REQUIRE(r.ok());
+    CHECK(r->empty());
+  }
+  // Member 2's first landmark and the one farthest from it trade vertices (a head's name on
+  // the tail and back): both are reported, on member 2 only, worst first.
+  const auto& V2 = meshes[2].V;
+  std::size_t far = 1;
+  for (std::size_t a = 2; a < k; ++a)
+    if ((V2.row(lm[2][a]) - V2.row(lm[2][0])).norm() > (V2.row(lm[2][far]) - V2.row(lm[2][0])).norm()) far = a;
+  std::swap(lm[2][0], lm[2][far]);
+  auto r = suspect_landmarks(meshes, lm, 0);
+  REQUIRE(r.ok());
+  REQUIRE(r->size() == 2);
+  std::vector<int> flagged;
+  for (const SuspectLandmark& s : *r) {
+    CHECK(s.member == 2);
+    CHECK(s.disagreement > 5 * s.typical);
+    flagged.push_back(s.landmark);
+  }
+  std::sort(flagged.begin(), flagged.end());
+  CHECK(flagged == std::vector<int>{0, static_cast<int>(far)});
+  CHECK((*r)[0].disagreement >= (*r)[1].disagreement);
+  // Errors are values: a vertex out of range names the member; too few landmarks: nothing to say.
+  lm[1][3] = static_cast<int>(meshes[1].V.rows());
+  auto bad = suspect_landmarks(meshes, lm, 0);
+  REQUIRE_FALSE(bad.ok());
+  CHECK(bad.status().message().find("mesh 1") != std::string::npos);
+  std::vector<std::vector<int>> three(4);
+  for (int i = 0; i < 4; ++i) three[i] = {lm[i][0], lm[i][1], lm[i][2]};
+  auto none = suspect_landmarks(meshes, three, 0);
+  REQUIRE(none.ok());
+  CHECK(none->empty());
+}

@@ -56,6 +56,8 @@ int run_consistent(const ConsistentArgs& a) {
     rep["options"]["threads"] = job.options.threads;
     rep["cpu_seconds"] = cpu_seconds();
     rep["peak_rss_mb"] = peak_rss_mb();
+    // Given landmarks most likely on another feature (also printed as warnings).
+    rep["landmark_warnings"] = r->landmark_warnings;
     if (Status s = write_json_atomic(a.report, rep); !s.ok()) return print_error(s);
   }
   if (!a.quiet) print_consistent_summary(r.value(), job.output, wall_seconds);

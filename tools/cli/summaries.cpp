@@ -109,6 +109,7 @@ void print_collection_summary(const pipeline::ConvertCollectionResult& r) {
 }
 
 void print_collection_warning(const pipeline::MakeCollectionResult& r) {
+  for (const std::string& w : r.landmark_warnings) std::fprintf(stderr, "spherekit: warning: %s\n", w.c_str());
   if (!r.refinement_warning.empty())
     std::fprintf(stderr, "spherekit: warning: step 6 failed (%s); the collection keeps the step-2 maps (locations from the reference)\n",
                  r.refinement_warning.c_str());

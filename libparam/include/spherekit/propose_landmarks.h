@@ -114,4 +114,23 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
                                                  const ProposeLandmarksOptions& options = {},
                                                  const ProgressFn& progress = {});
 
+/// A landmark of given, corresponding landmark sets whose geodesic distances to the others on
+/// one member disagree with the reference member's far beyond that member's other landmarks'
+/// (the rule that leaves a mismatched extremity out of a proposal, step 3): most likely on
+/// another feature there (a wrong vertex index, two names swapped in one file). Distances
+/// cannot see a left/right swap of a symmetric shape's pair; those pass.
+struct SuspectLandmark {
+  int member = 0;            ///< index into the meshes
+  int landmark = 0;          ///< index into the landmark lists
+  double disagreement = 0;   ///< median over its pairs of |log(d_member / d_reference)|
+  double typical = 0;        ///< the member's median over all pairs
+};
+
+/// Checks corresponding landmark sets (`landmarks[i]`: member i's vertices, the same feature at
+/// the same index on every member) against the reference member's: edge-graph geodesic
+/// distances / sqrt(area). Fewer than 4 or more than 64 landmarks: an empty list. Errors:
+/// a mesh without faces, a vertex out of range (InvalidInput, naming the member's index).
+Result<std::vector<SuspectLandmark>> suspect_landmarks(const std::vector<TriMesh>& meshes,
+                                                       const std::vector<std::vector<int>>& landmarks, int reference);
+
 }  // namespace spherekit

@@ -39,6 +39,8 @@ struct MakeCollectionResult {
   formats::CollectionManifest manifest;  ///< as written to the folder
   /// The step-6 failure (member name: reason) when the collection kept the step-2 maps.
   std::string refinement_warning;
+  /// Given landmarks that are most likely on another feature (suspect_landmarks), one line each.
+  std::vector<std::string> landmark_warnings;
   double wall_seconds = 0;
 };
 

@@ -2,7 +2,10 @@
 // read, the report, and the failure contract.
 #include <catch2/catch.hpp>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_shorthands.h"
 #include "test_paths.h"
@@ -71,4 +74,65 @@ TEST_CASE("run proposes landmarks for meshes that come without feature files", "
     CHECK(fs::is_regular_file(out + "/collection/" + std::string(m) + ".sphere.obj"));
   }
   CHECK(read_json(out + "/landmarks_report.json")["members"].size() == 2);
+}
+
+// Several meshes with one landmark file each: the files' correspondence is checked (a landmark
+// most likely on another feature is a warning naming file and landmark; a missing name an error).
+TEST_CASE("check --landmarks with several meshes: swapped names are warned about, a missing one is an error", "[cli]") {
+  const std::string dir = temp_dir("landmarks_check_set");
+  const std::string cap = temp_dir("landmarks_check_set_capture");
+  REQUIRE(sk("samples -o " + q(dir) + " --members 3 --target-vertices 1500", cap).exit_code == 0);
+  const std::string meshes = q(dir + "/sample_a.obj") + " " + q(dir + "/sample_b.obj") + " " + q(dir + "/sample_c.obj");
+  auto good = sk("check " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt") + " " + q(dir + "/sample_b.lm.txt") +
+                     " " + q(dir + "/sample_c.lm.txt"),
+                 cap);
+  INFO(good.err);
+  CHECK(good.exit_code == 0);
+  CHECK(good.out.find("agree with the first file's") != std::string::npos);
+  CHECK(good.err.find("warning") == std::string::npos);
+  // sample_b's nose and tail tips trade vertices.
+  std::string text, line;
+  {
+    std::ifstream in(dir + "/sample_b.lm.txt");
+    std::string nose, tail;
+    std::vector<std::pair<std::string, std::string>> rows;
+    while (std::getline(in, line)) {
+      std::istringstream s(line);
+      std::string name, v;
+      if (!(s >> name >> v)) continue;
+      if (name == "nose_tip") nose = v;
+      if (name == "tail_tip") tail = v;
+      rows.emplace_back(name, v);
+    }
+    REQUIRE_FALSE(nose.empty());
+    REQUIRE_FALSE(tail.empty());
+    for (auto& [name, v] : rows) text += name + " " + (name == "nose_tip" ? tail : name == "tail_tip" ? nose : v) + "\n";
+  }
+  const std::string bad = dir + "/b_swapped.lm.txt";
+  std::ofstream(bad) << text;
+  auto warned = sk("check " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt") + " " + q(bad) + " " +
+                       q(dir + "/sample_c.lm.txt"),
+                   cap);
+  CHECK(warned.exit_code == 0);  // the files are valid; only their correspondence is in doubt
+  CHECK(warned.err.find("b_swapped.lm.txt: landmark 'nose_tip'") != std::string::npos);
+  CHECK(warned.err.find("b_swapped.lm.txt: landmark 'tail_tip'") != std::string::npos);
+  CHECK(warned.err.find("sample_c") == std::string::npos);
+  auto js = sk("check --json " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt") + " " + q(bad) + " " +
+                   q(dir + "/sample_c.lm.txt"),
+               cap);
+  REQUIRE(js.exit_code == 0);
+  const auto j = nlohmann::json::parse(js.out);
+  REQUIRE(j.size() == 3);
+  CHECK(j[0]["landmarks"]["suspect"].empty());
+  CHECK(j[1]["landmarks"]["suspect"].size() == 2);
+  CHECK(j[2]["landmarks"]["suspect"].empty());
+  // A file without one of the first file's names: one error line naming it and the name.
+  const std::string shorter = dir + "/c_short.lm.txt";
+  std::ofstream(shorter) << text.substr(0, text.find('\n') + 1);
+  auto missing = sk("check " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt") + " " + q(dir + "/sample_b.lm.txt") +
+                        " " + q(shorter),
+                    cap);
+  require_failure(missing, 3, "c_short.lm.txt", "no landmark");
+  // One file per mesh.
+  require_failure(sk("check " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt"), cap), 2, "--landmarks", "per MESH");
 }

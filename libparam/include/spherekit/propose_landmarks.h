@@ -115,15 +115,17 @@ Result<ProposeLandmarksResult> propose_landmarks(const std::vector<TriMesh>& mes
                                                  const ProgressFn& progress = {});
 
 /// A landmark of given, corresponding landmark sets whose geodesic distances to the others on
-/// one member disagree with the reference member's far beyond that member's other landmarks'
-/// (the rule that leaves a mismatched extremity out of a proposal, step 3): most likely on
-/// another feature there (a wrong vertex index, two names swapped in one file). Distances
-/// cannot see a left/right swap of a symmetric shape's pair; those pass.
+/// one member disagree with the reference member's far beyond those among that member's other
+/// landmarks (a stricter form of the rule that leaves a mismatched extremity out of a proposal,
+/// step 3): most likely on another feature there (a wrong vertex index, two names swapped in one
+/// file). Distances cannot see a left/right swap of a symmetric shape's pair; those pass.
 struct SuspectLandmark {
   int member = 0;            ///< index into the meshes
   int landmark = 0;          ///< index into the landmark lists
   double disagreement = 0;   ///< median over its pairs of |log(d_member / d_reference)|
-  double typical = 0;        ///< the member's median over all pairs
+  /// The same over the pairs among the member's other landmarks still unreported when it was
+  /// (reported while disagreement > 0.4 and > 5 typical, worst first, while more than 3 remain).
+  double typical = 0;
 };
 
 /// Checks corresponding landmark sets (`landmarks[i]`: member i's vertices, the same feature at

@@ -219,6 +219,45 @@ Result<std::optional<RefinedMember>> refine_added_member(const formats::Collecti
   return std::optional<RefinedMember>(rr.members[1]);
 }
 
+// A failed map whose landmarks were found suspect says so in its one error line: a landmark on
+// another feature forces a twisted map, which fails as a solver error that names no landmark
+// (sample_c with its nose and tail tips swapped: "the stretch optimization did not converge").
+Status with_landmark_hint(const Status& s, const std::vector<std::string>& suspects, const std::string& lm_file) {
+  if (suspects.empty() || s.code() == ErrorCode::Cancelled) return s;
+  std::string names;
+  for (const std::string& n : suspects) names += (names.empty() ? "'" : ", '") + n + "'";
+  return Status(s.code(), s.message() + " (most likely misplaced in " + lm_file + ": " + names + ")");
+}
+
+// The added mesh's landmarks checked against the reference member's (suspect_landmarks), as
+// make_collection checks given files. The reference's mesh is read from its source; where it
+// cannot be (moved, or the reference is the member being replaced) nothing is said.
+std::vector<std::string> added_landmark_warnings(const formats::Collection& c, int replacing, const TriMesh& mesh,
+                                                 const std::vector<int>& fv, const std::string& lm_file,
+                                                 std::vector<std::string>* suspect_names) {
+  std::vector<std::string> out;
+  if (!c.manifest.reference) return out;
+  const int ref = c.manifest.member_index(*c.manifest.reference);
+  if (ref < 0 || ref == replacing) return out;
+  const formats::CollectionMember& rm = c.manifest.members[static_cast<size_t>(ref)];
+  if (!rm.feature_vertices || !rm.source) return out;
+  auto ref_mesh = read_accepted_mesh(*rm.source);
+  if (!ref_mesh.ok()) return out;
+  std::vector<int> rf;
+  for (long long v : *rm.feature_vertices) rf.push_back(static_cast<int>(v));
+  auto suspects = suspect_landmarks(std::vector<TriMesh>{*ref_mesh, mesh}, std::vector<std::vector<int>>{rf, fv}, 0);
+  if (!suspects.ok()) return out;
+  const std::vector<std::string> names = c.manifest.feature_names();
+  for (const SuspectLandmark& x : *suspects) {
+    suspect_names->push_back(names[static_cast<size_t>(x.landmark)]);
+    out.push_back(format_text("%s: landmark '%s' is not where %s's is: its distances to the others differ by a factor %.2f "
+                              "(the other landmarks: %.2f); misplaced, or on another feature?",
+                              lm_file.c_str(), names[static_cast<size_t>(x.landmark)].c_str(), rm.name.c_str(),
+                              std::exp(x.disagreement), std::exp(x.typical)));
+  }
+  return out;
+}
+
 formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const ConsistentParamOptions& o,
                                         const std::string& refinement_failure) {
   const ConsistentParamResult& r = out.maps;
@@ -323,21 +362,27 @@ Result<MakeCollectionResult> make_collection(const MakeCollectionJob& a, const P
   // Given landmark files are taken as they are, but a landmark on another feature on some
   // member (a wrong index, two names swapped in one file) twists that member's map without any
   // error: it is reported (the rule that leaves such an extremity out of a proposal).
+  // A member's landmarks by their file (the built-in samples' by the member's name).
+  auto m_label = [](const CollectionInput& m) { return m.features_file == "builtin" ? m.name : m.features_file; };
+  std::vector<std::vector<std::string>> suspect_names(out.members.size());
   if (auto suspects = suspect_landmarks(meshes, features, out.reference); suspects.ok())
-    for (const SuspectLandmark& x : *suspects)
+    for (const SuspectLandmark& x : *suspects) {
+      suspect_names[static_cast<size_t>(x.member)].push_back(out.feature_names[static_cast<size_t>(x.landmark)]);
       out.landmark_warnings.push_back(format_text(
-          "%s (%s): landmark '%s' is not where %s's is: its distances to the others differ by a factor %.2f "
-          "(the member's other landmarks: %.2f); misplaced, or on another feature?",
-          out.members[static_cast<size_t>(x.member)].name.c_str(),
-          out.members[static_cast<size_t>(x.member)].features_file.c_str(),
+          "%s: landmark '%s' is not where %s's is: its distances to the others differ by a factor %.2f "
+          "(the other landmarks: %.2f); misplaced, or on another feature?",
+          m_label(out.members[static_cast<size_t>(x.member)]).c_str(),
           out.feature_names[static_cast<size_t>(x.landmark)].c_str(),
           out.members[static_cast<size_t>(out.reference)].name.c_str(), std::exp(x.disagreement), std::exp(x.typical)));
+    }
   MeshFailure failure;
   auto result = parameterize_consistent(meshes, features, o, progress, &failure);
   if (!result.ok()) {
     // The mesh by its file, not by its index.
     if (failure.mesh < 0) return result.status();
-    return with_file(failure.reason, out.members[static_cast<size_t>(failure.mesh)].source);
+    const CollectionInput& m = out.members[static_cast<size_t>(failure.mesh)];
+    return with_file(with_landmark_hint(failure.reason, suspect_names[static_cast<size_t>(failure.mesh)], m.features_file),
+                     m.source);
   }
   out.maps = std::move(result).value();
   const ConsistentParamResult& r = out.maps;
@@ -389,6 +434,8 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
   const int nv = static_cast<int>(mesh.V.rows());
   SPHEREKIT_ASSIGN_OR_RETURN(std::vector<int> fv, features_in_order(lm, nv, c.manifest.feature_names()));
   const std::vector<Eigen::Vector3d> F = c.manifest.locations();
+  std::vector<std::string> suspect_names;
+  out.landmark_warnings = added_landmark_warnings(c, existing, mesh, fv, lm, &suspect_names);
 
   formats::CollectionMember e;
   e.name = name;
@@ -415,7 +462,7 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
     if (opt.is_object() && opt.contains("seed") && opt["seed"].is_number_unsigned() && !a.seed_given)
       o.sphere.seed = opt["seed"].get<std::uint64_t>();
     auto result = parameterize_sphere_constrained(mesh, fv, F, o, progress);
-    if (!result.ok()) return with_file(result.status(), a.mesh);
+    if (!result.ok()) return with_file(with_landmark_hint(result.status(), suspect_names, lm), a.mesh);
     out.map = std::move(result).value();
     SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
     e.result = map_entry_json(out.map);

@@ -1,6 +1,7 @@
 // `spherekit landmarks`: proposed landmark files that `check --landmarks` and `consistent`
 // read, the report, and the failure contract.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -76,6 +77,45 @@ TEST_CASE("run proposes landmarks for meshes that come without feature files", "
   CHECK(read_json(out + "/landmarks_report.json")["members"].size() == 2);
 }
 
+namespace {
+
+// A copy of a landmark file with the nose and tail tips' vertices traded.
+std::string swapped_nose_and_tail(const std::string& lm_file, const std::string& out) {
+  std::ifstream in(lm_file);
+  std::string line, nose, tail, text;
+  std::vector<std::pair<std::string, std::string>> rows;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string name, v;
+    if (!(s >> name >> v)) continue;
+    if (name == "nose_tip") nose = v;
+    if (name == "tail_tip") tail = v;
+    rows.emplace_back(name, v);
+  }
+  REQUIRE_FALSE(nose.empty());
+  REQUIRE_FALSE(tail.empty());
+  for (auto& [name, v] : rows) text += name + " " + (name == "nose_tip" ? tail : name == "tail_tip" ? nose : v) + "\n";
+  std::ofstream(out) << text;
+  return text;
+}
+
+// The user is told, whether the maps could be made (a warning per landmark) or not (the one
+// error line names them).
+void require_told(const CliRun& r, const std::string& file) {
+  INFO("exit " << r.exit_code << "\nstderr: " << r.err);
+  if (r.exit_code == 0) {
+    CHECK(r.err.find(file + ": landmark 'nose_tip'") != std::string::npos);
+    CHECK(r.err.find(file + ": landmark 'tail_tip'") != std::string::npos);
+  } else {
+    CHECK(r.exit_code == 5);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.find("most likely misplaced in") != std::string::npos);
+    CHECK(r.err.find("'nose_tip', 'tail_tip'") != std::string::npos);
+  }
+}
+
+}  // namespace
+
 // Several meshes with one landmark file each: the files' correspondence is checked (a landmark
 // most likely on another feature is a warning naming file and landmark; a missing name an error).
 TEST_CASE("check --landmarks with several meshes: swapped names are warned about, a missing one is an error", "[cli]") {
@@ -91,25 +131,8 @@ TEST_CASE("check --landmarks with several meshes: swapped names are warned about
   CHECK(good.out.find("agree with the first file's") != std::string::npos);
   CHECK(good.err.find("warning") == std::string::npos);
   // sample_b's nose and tail tips trade vertices.
-  std::string text, line;
-  {
-    std::ifstream in(dir + "/sample_b.lm.txt");
-    std::string nose, tail;
-    std::vector<std::pair<std::string, std::string>> rows;
-    while (std::getline(in, line)) {
-      std::istringstream s(line);
-      std::string name, v;
-      if (!(s >> name >> v)) continue;
-      if (name == "nose_tip") nose = v;
-      if (name == "tail_tip") tail = v;
-      rows.emplace_back(name, v);
-    }
-    REQUIRE_FALSE(nose.empty());
-    REQUIRE_FALSE(tail.empty());
-    for (auto& [name, v] : rows) text += name + " " + (name == "nose_tip" ? tail : name == "tail_tip" ? nose : v) + "\n";
-  }
   const std::string bad = dir + "/b_swapped.lm.txt";
-  std::ofstream(bad) << text;
+  const std::string text = swapped_nose_and_tail(dir + "/sample_b.lm.txt", bad);
   auto warned = sk("check " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt") + " " + q(bad) + " " +
                        q(dir + "/sample_c.lm.txt"),
                    cap);
@@ -135,4 +158,28 @@ TEST_CASE("check --landmarks with several meshes: swapped names are warned about
   require_failure(missing, 3, "c_short.lm.txt", "no landmark");
   // One file per mesh.
   require_failure(sk("check " + meshes + " --landmarks " + q(dir + "/sample_a.lm.txt"), cap), 2, "--landmarks", "per MESH");
+}
+
+// consistent and add check given files before mapping: a member whose nose and tail tips are
+// swapped is named, as a warning or in the failure's one line (a twisted map may not converge).
+TEST_CASE("consistent and add name the landmarks of a file whose nose and tail are swapped", "[cli]") {
+  const std::string dir = temp_dir("landmarks_swapped_given");
+  const std::string cap = temp_dir("landmarks_swapped_given_capture");
+  REQUIRE(sk("samples -o " + q(dir) + " --members 3 --target-vertices 1500", cap).exit_code == 0);
+  const std::string bad = dir + "/c_swapped.lm.txt";
+  swapped_nose_and_tail(dir + "/sample_c.lm.txt", bad);
+  const std::string a = dir + "/sample_a", b = dir + "/sample_b", c = dir + "/sample_c";
+  const CliRun made = sk("consistent -q -o " + q(dir + "/coll3") + " " + q(a + ".obj") + " " + q(b + ".obj") + " " +
+                             q(c + ".obj") + " --features " + q(a + ".lm.txt") + " " + q(b + ".lm.txt") + " " + q(bad),
+                         cap);
+  require_told(made, "c_swapped.lm.txt");
+  // add: against the collection's reference (sample_a, read from its source).
+  const std::string coll = dir + "/coll2";
+  REQUIRE(sk("consistent -q -o " + q(coll) + " " + q(a + ".obj") + " " + q(b + ".obj"), cap).exit_code == 0);
+  require_told(sk("add -q " + q(coll) + " " + q(c + ".obj") + " --features " + q(bad), cap), "c_swapped.lm.txt");
+  // Its right file: no word about landmarks.
+  const CliRun good = sk("add -q " + q(coll) + " " + q(c + ".obj"), cap);
+  INFO(good.err);
+  CHECK(good.exit_code == 0);
+  CHECK(good.err.find("landmark") == std::string::npos);
 }

@@ -85,6 +85,7 @@ int run_add(const AddArgs& a) {
   progress.finish();
   if (cancel_requested()) return print_error(cancelled_status());
   if (!r.ok()) return print_error(r.status());
+  for (const std::string& w : r->landmark_warnings) std::fprintf(stderr, "spherekit: warning: %s\n", w.c_str());
   if (!a.report.empty()) {
     // Per-task measures (read by `submit --verify`): peak memory is per process.
     Json rep{{"name", r->name}, {"map", r->map_path}, {"collection", job.dir}, {"registered", r->registered}};
@@ -92,6 +93,7 @@ int run_add(const AddArgs& a) {
     rep["times"]["wall"] = r->wall_seconds;
     rep["cpu_seconds"] = cpu_seconds();
     rep["peak_rss_mb"] = peak_rss_mb();
+    rep["landmark_warnings"] = r->landmark_warnings;
     if (Status s = write_json_atomic(a.report, rep); !s.ok()) return print_error(s);
   }
   if (!a.quiet) print_add_summary(r.value(), job);

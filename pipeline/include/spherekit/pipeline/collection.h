@@ -81,6 +81,9 @@ struct AddToCollectionResult {
   ConstrainedParamResult map;  ///< registered: the map and its measures only (no network, no times)
   bool registered = false;
   formats::CollectionManifest manifest;  ///< as written
+  /// Its landmarks most likely on another feature, judged against the collection's reference
+  /// member (suspect_landmarks; nothing when that member's mesh cannot be read), one line each.
+  std::vector<std::string> landmark_warnings;
   double wall_seconds = 0;
 };
 

@@ -78,6 +78,7 @@ void bind_pipeline(pyb::module_& m) {
         pyb::dict out = to_python(formats::collection_manifest_json(r.manifest)).cast<pyb::dict>();
         out["output"] = output;
         out["refinement_warning"] = r.refinement_warning;
+        out["landmark_warnings"] = to_python(pipeline::Json(r.landmark_warnings));
         return out;
       },
       pyb::arg("meshes"), pyb::arg("output"), pyb::kw_only(), pyb::arg("features") = std::vector<std::string>{},
@@ -86,7 +87,8 @@ void bind_pipeline(pyb::module_& m) {
       pyb::arg("seed") = SphereParamOptions{}.seed, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
       "A consistent collection folder from mesh files (as `spherekit consistent MESH... -o OUTPUT`): each\n"
       "mesh's landmarks from `features` (one file per mesh) or NAME.lm.txt beside it. The folder appears\n"
-      "only when complete. Returns its manifest (collection.json) as a dict.");
+      "only when complete. Returns its manifest (collection.json) as a dict, with `landmark_warnings`:\n"
+      "given landmarks most likely on another feature (as the CLI's warnings).");
 
   m.def(
       "add_to_collection",
@@ -115,6 +117,7 @@ void bind_pipeline(pyb::module_& m) {
         out["registered"] = r.registered;
         out["result"] = to_python(pipeline::map_entry_json(r.map));
         out["manifest"] = to_python(formats::collection_manifest_json(r.manifest));
+        out["landmark_warnings"] = to_python(pipeline::Json(r.landmark_warnings));
         return out;
       },
       pyb::arg("dir"), pyb::arg("mesh"), pyb::kw_only(), pyb::arg("features") = "", pyb::arg("name") = "",

@@ -36,6 +36,7 @@ def test_make_collection_writes_the_cli_folder(collection, samples, tmp_path):
                                   remesh_size=33, effort=1, threads=1)
     assert [m["name"] for m in manifest["meshes"]] == ["sample_a", "sample_b"]
     assert manifest["output"] == str(out)
+    assert manifest["landmark_warnings"] == []  # the samples' files correspond
     same_tree(collection, out)  # the CLI ran with all cores: the bytes do not depend on it
 
 
@@ -47,6 +48,7 @@ def test_add_to_collection_writes_what_add_writes(exe, collection, samples, tmp_
     r = sk.add_to_collection(str(py_col), str(samples / "sample_c.obj"), threads=2)
     assert r["name"] == "sample_c" and not r["registered"]
     assert r["result"]["flipped_faces"] == 0
+    assert r["landmark_warnings"] == []
     assert "sample_c" in [m["name"] for m in r["manifest"]["meshes"]]
     same_tree(cli_col, py_col)
 

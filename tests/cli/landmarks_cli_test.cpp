@@ -165,7 +165,9 @@ TEST_CASE("check --landmarks with several meshes: swapped names are warned about
 TEST_CASE("consistent and add name the landmarks of a file whose nose and tail are swapped", "[cli]") {
   const std::string dir = temp_dir("landmarks_swapped_given");
   const std::string cap = temp_dir("landmarks_swapped_given_capture");
-  REQUIRE(sk("samples -o " + q(dir) + " --members 3 --target-vertices 1500", cap).exit_code == 0);
+  // 700 vertices: both outcomes occur (consistent's map of sample_c fails, add's is made with
+  // warnings) in 7 s; at 1500 both failed, in 42 s (several minutes under the sanitizers).
+  REQUIRE(sk("samples -o " + q(dir) + " --members 3 --target-vertices 700", cap).exit_code == 0);
   const std::string bad = dir + "/c_swapped.lm.txt";
   swapped_nose_and_tail(dir + "/sample_c.lm.txt", bad);
   const std::string a = dir + "/sample_a", b = dir + "/sample_b", c = dir + "/sample_c";
@@ -178,7 +180,7 @@ TEST_CASE("consistent and add name the landmarks of a file whose nose and tail a
   REQUIRE(sk("consistent -q -o " + q(coll) + " " + q(a + ".obj") + " " + q(b + ".obj"), cap).exit_code == 0);
   require_told(sk("add -q " + q(coll) + " " + q(c + ".obj") + " --features " + q(bad), cap), "c_swapped.lm.txt");
   // Its right file: no word about landmarks.
-  const CliRun good = sk("add -q " + q(coll) + " " + q(c + ".obj"), cap);
+  const CliRun good = sk("add -q " + q(coll) + " " + q(c + ".obj") + " --name right_c", cap);
   INFO(good.err);
   CHECK(good.exit_code == 0);
   CHECK(good.err.find("landmark") == std::string::npos);

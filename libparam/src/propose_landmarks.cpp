@@ -771,6 +771,13 @@ bool repin_maps(const std::vector<TriMesh>& meshes, const std::vector<Member>& m
   return true;
 }
 
+// The upper median of a non-empty list (the mismatch rules below).
+double median(std::vector<double> v) {
+  auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
 // An extremity whose distances to the other kept ones are wrong on some member far beyond
 // that member's other extremities' (the median |log(d_ref / d_member)| of its pairs above
 // kMismatchFactor times the median over all the member's pairs, and above kMismatchFloor) was
@@ -787,11 +794,6 @@ constexpr double kMismatchFloor = 0.2;  // a factor 1.22: below it, distances ar
 
 int drop_mismatched(const std::vector<Member>& mem, int ref, const std::vector<std::vector<int>>& to,
                     std::vector<int>& keep, std::vector<char>& dropped) {
-  auto median = [](std::vector<double> v) {
-    auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  };
   const Member& rm = mem[ref];
   int count = 0;
   while (keep.size() > 3) {
@@ -1442,11 +1444,6 @@ Result<std::vector<SuspectLandmark>> suspect_landmarks(const std::vector<TriMesh
       for (std::size_t b = 0; b < k; ++b) Di[a * k + b] = d[static_cast<std::size_t>(lm[b])];
     }
   }
-  auto median = [](std::vector<double> v) {
-    auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
-  };
   // Per member, worst first while more than 3 remain: a landmark whose pairs disagree far beyond
   // the pairs among the others. Leaving the landmark itself out of the comparison matters: two
   // names swapped spoil 13 of a cat's 28 pairs (the median of all pairs 0.17 where the right

@@ -55,6 +55,14 @@ TriMesh mirrored(const TriMesh& m) {
   return out;
 }
 
+// The built-in collection's first 4 members at 2000 vertices (proportions and poses differ).
+Result<std::vector<samples::SampleMesh>> four_samples() {
+  samples::SampleCollectionOptions so;
+  so.members = 4;
+  so.target_vertices = 2000;
+  return samples::make_sample_collection(so);
+}
+
 double mesh_area_for_test(const TriMesh& m) {
   double a = 0;
   for (Eigen::Index f = 0; f < m.F.rows(); ++f)
@@ -445,10 +453,7 @@ TEST_CASE("propose_landmarks: a mirrored member's flip is resolved or flagged", 
 // symmetric: distances alone cannot tell a left paw from a right one. Every proposed
 // landmark must lie at the reference landmark's ground-truth image.
 TEST_CASE("propose_landmarks: left and right of differently posed symmetric members, by sphere maps", "[param]") {
-  samples::SampleCollectionOptions so;
-  so.members = 4;
-  so.target_vertices = 2000;
-  auto c = samples::make_sample_collection(so);
+  auto c = four_samples();
   REQUIRE(c.ok());
   std::vector<TriMesh> meshes;
   for (const auto& s : *c) meshes.push_back(s.mesh);
@@ -595,10 +600,7 @@ TEST_CASE("shared ICT heads with decimated members: the openings are matched by 
 }
 
 TEST_CASE("suspect_landmarks: a given file's swapped names are reported, right files pass", "[param]") {
-  samples::SampleCollectionOptions so;
-  so.members = 4;
-  so.target_vertices = 2000;
-  auto c = samples::make_sample_collection(so);
+  auto c = four_samples();
   REQUIRE(c.ok());
   std::vector<TriMesh> meshes;
   std::vector<std::vector<int>> lm;

@@ -378,12 +378,13 @@ class Refiner {
   Status optimize_level(const OptimizerSettings& s) {
     update_hole_faces();
     st_.update_areas();
+    RingIndex rings;  // this level's: the passes below do not change the connectivity
     for (int g = 0; g < s.global_iter; ++g) {
       std::uint64_t pass_key = s_.seed * 0xd1b54a32d192ed03ULL + static_cast<std::uint64_t>(stats_->passes) * 0x8cb92ba72f3d8dd7ULL;
       bool exceeded = false;
       int rounds = optimize_all(
           st_, s, pass_key, [&] { return report_progress(progress_, "optimize", st_.alive_vertices, -1.0); },
-          &pool_, &exceeded);
+          &pool_, &exceeded, &rings);
       if (rounds < 0) return Status(ErrorCode::Cancelled, "cancelled during optimization");
       if (exceeded)
         return Status(ErrorCode::SolverFailed,

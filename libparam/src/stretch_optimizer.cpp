@@ -605,10 +605,17 @@ bool newton_move(const SphereState& st, RingScratch& ring, const OptimizerSettin
 void build_ring_index(const SphereState& st, WorkerPool* pool, RingIndex* index) {
   const int nv = static_cast<int>(st.S.rows());
   index->start.assign(static_cast<size_t>(nv) + 1, 0);
-  for (int v = 0; v < nv; ++v)
+  // Ring sizes in parallel (reading every vertex's face list is cache misses), then the
+  // offsets by a prefix sum over the one array.
+  auto size = [&](int v, int) {
     index->start[static_cast<size_t>(v) + 1] =
-        index->start[static_cast<size_t>(v)] +
-        (st.vertex_alive[static_cast<size_t>(v)] ? static_cast<int>(st.vf[static_cast<size_t>(v)].size()) : 0);
+        st.vertex_alive[static_cast<size_t>(v)] ? static_cast<int>(st.vf[static_cast<size_t>(v)].size()) : 0;
+  };
+  if (pool)
+    pool->parallel_for(nv, 256, 1024, size);
+  else
+    for (int v = 0; v < nv; ++v) size(v, 0);
+  for (int v = 0; v < nv; ++v) index->start[static_cast<size_t>(v) + 1] += index->start[static_cast<size_t>(v)];
   index->faces.resize(static_cast<size_t>(index->start.back()));
   index->corners.resize(2 * index->faces.size());
   auto fill = [&](int v, int) {
@@ -690,7 +697,8 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
 }
 
 int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
-                 const std::function<bool()>& keep_going, WorkerPool* pool, bool* work_exceeded) {
+                 const std::function<bool()>& keep_going, WorkerPool* pool, bool* work_exceeded,
+                 RingIndex* ring_cache) {
   const int nv = static_cast<int>(st.S.rows());
   auto is_fixed = [&](int v) { return !st.fixed.empty() && st.fixed[static_cast<size_t>(v)]; };
   std::vector<double> credit(static_cast<size_t>(nv), 0.0);
@@ -707,29 +715,15 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   };
   WorkerPool serial(1);
   WorkerPool& workers = pool ? *pool : serial;
-  // Each alive vertex's face-walk corners (for f around v, the two other corners of f, in
-  // vf order): the rounds below visit neighbours in exactly this order, from one contiguous
-  // list instead of a face list and the faces' corners (cache misses, on the calling thread).
-  std::vector<int> walk_start(static_cast<size_t>(nv) + 1, 0), walk;
-  for (int v = 0; v < nv; ++v)
-    walk_start[static_cast<size_t>(v) + 1] =
-        walk_start[static_cast<size_t>(v)] +
-        (st.vertex_alive[static_cast<size_t>(v)] ? 2 * static_cast<int>(st.vf[static_cast<size_t>(v)].size()) : 0);
-  walk.resize(static_cast<size_t>(walk_start.back()));
-  workers.parallel_for(nv, 256, 1024, [&](int v, int) {
-    if (!st.vertex_alive[static_cast<size_t>(v)]) return;
-    int* out = walk.data() + walk_start[static_cast<size_t>(v)];
-    for (int f : st.vf[static_cast<size_t>(v)])
-      for (int k = 0; k < 3; ++k) {
-        const int w = st.F[static_cast<size_t>(f)][k];
-        if (w != v) *out++ = w;
-      }
-  });
-  RingIndex index;
-  build_ring_index(st, &workers, &index);
+  // The level's rings (built here unless the caller's cache holds this level's): the rounds
+  // below visit each vertex's neighbours as its ring's other corners, from one contiguous
+  // list (the face lists and the faces' corners were cache misses on the calling thread).
+  RingIndex own_index;
+  RingIndex& index = ring_cache ? *ring_cache : own_index;
+  if (index.start.size() != static_cast<size_t>(nv) + 1) build_ring_index(st, &workers, &index);
   auto corners = [&](int v) {
-    return std::span<const int>(walk.data() + walk_start[static_cast<size_t>(v)],
-                                walk.data() + walk_start[static_cast<size_t>(v) + 1]);
+    return std::span<const int>(index.corners.data() + 2 * static_cast<size_t>(index.start[static_cast<size_t>(v)]),
+                                index.corners.data() + 2 * static_cast<size_t>(index.start[static_cast<size_t>(v) + 1]));
   };
   std::vector<RingScratch> rings(static_cast<size_t>(workers.threads()));
   std::vector<Candidate> cand;
@@ -822,14 +816,19 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       for (int c = 0; c < ncol; ++c) {
         const int* cls = order.data() + class_start[static_cast<size_t>(c)];
         const int count = class_start[static_cast<size_t>(c) + 1] - class_start[static_cast<size_t>(c)];
-        workers.parallel_for(count, 4, 8, [&](int j, int thread) { compute_candidate(cls[j], round, thread); });
+        // A class is an independent set: no member's ring holds another member, so each
+        // move is written at once by the thread that computed it (no other member reads it).
+        workers.parallel_for(count, 4, 8, [&](int j, int thread) {
+          compute_candidate(cls[j], round, thread);
+          const Candidate& cd = cand[static_cast<size_t>(cls[j])];
+          if (cd.moved) st.S.row(active[static_cast<size_t>(cls[j])]) = cd.x.transpose();
+        });
         for (int j = 0; j < count; ++j) {
           const int i = cls[j];
           const int v = active[static_cast<size_t>(i)];
           credit[static_cast<size_t>(v)] = 0;  // evaluated at the current neighbourhood
           const Candidate& cd = cand[static_cast<size_t>(i)];
           if (!cd.moved) continue;
-          st.S.row(v) = cd.x.transpose();
           for (int w : corners(v)) {
             credit[static_cast<size_t>(w)] += 0.3 * cd.dist / 2.0;
             if (!is_fixed(w) && listed_in[static_cast<size_t>(w)] != round) {

@@ -316,3 +316,36 @@ TEST_CASE("a pass over its work bound ends early, at the same round for any thre
   CHECK(optimize_in_place(P, m.F, w, sw, fixed, s, {}, &S).ok());
   CHECK(count_flipped_faces(m.F, S) == 0);
 }
+
+TEST_CASE("passes that share the level's ring index give the maps of passes that build their own",
+          "[param][sphere][energy]") {
+  // The refiner builds a level's ring index once for all its passes (the connectivity does
+  // not change between them); the maps must be those of passes that each build their own,
+  // for any thread count.
+  const TriMesh m = test::elongated(3, 4.0);
+  RowMat3d S0 = m.V;
+  S0.rowwise().normalize();
+  REQUIRE(count_flipped_faces(m.F, S0) == 0);
+  const RowMatXd P = m.V;
+  const OptimizerSettings s = settings_for_effort(2);
+  auto two_passes = [&](int threads, bool share) {
+    SphereState st = make_state(m, S0, P);
+    WorkerPool pool(threads);
+    RingIndex cache;
+    const int* built = nullptr;
+    for (int pass = 0; pass < 2; ++pass) {
+      REQUIRE(optimize_all(st, s, 11 + static_cast<std::uint64_t>(pass), {}, &pool, nullptr, share ? &cache : nullptr) > 0);
+      if (!share) continue;
+      REQUIRE(cache.start.size() == static_cast<size_t>(m.V.rows()) + 1);
+      if (pass == 0) built = cache.corners.data();
+      CHECK(cache.corners.data() == built);  // the second pass read the first pass's index
+    }
+    return st.S;
+  };
+  const RowMat3d own = two_passes(1, false);
+  CHECK(count_flipped_faces(m.F, own) == 0);
+  CHECK(own != S0);
+  CHECK(two_passes(1, true) == own);
+  CHECK(two_passes(2, true) == own);
+  CHECK(two_passes(2, false) == own);
+}

@@ -160,10 +160,12 @@ bool optimize_vertex(const SphereState& st, int v, std::uint64_t key, const Opti
 /// Returns the number of rounds, or -1 if cancelled by `keep_going`. `pool` runs the
 /// candidate moves (null: on the calling thread only).
 /// With s.max_pass_work > 0, a pass that exceeds that work ends early and sets
-/// *work_exceeded (if given).
+/// *work_exceeded (if given). `ring_cache` (optional): the level's RingIndex, built into it
+/// when empty and reused by later passes over the same connectivity (the caller empties it
+/// when the connectivity changes).
 int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass_key,
                  const std::function<bool()>& keep_going, WorkerPool* pool = nullptr,
-                 bool* work_exceeded = nullptr);
+                 bool* work_exceeded = nullptr, RingIndex* ring_cache = nullptr);
 
 /// The floor of OptimizerSettings::max_pass_work's budget, in vertices: coarse levels of a
 /// few dozen vertices take up to 100 optimizations per vertex on normal inputs (FAUST, 33).

@@ -201,7 +201,7 @@ class MemberFit {
   // surface to first order, so low-frequency slides, which the energy penalizes only
   // weakly, are not lost to motion off the surface), Levenberg-damped by `damping`; each
   // point then walks on the surface to the point nearest its stepped position.
-  Status run(const std::function<bool()>& keep_going, double* e_before, double* e_after) {
+  Status run(const std::function<bool()>& keep_going, double* e_before, double* e_after, int* crushed_after) {
     const int nv = static_cast<int>(t_.V.rows());
     std::vector<int> index(static_cast<size_t>(nv), -1);
     int nf = 0;
@@ -264,7 +264,11 @@ class MemberFit {
       // Move all points together (a slide of a whole region keeps the template's spherical
       // triangulation valid only if its points move at once); points of faces that would be
       // inverted go back, until every face is positive (exact predicate), and those then try
-      // half and quarter steps one at a time, in vertex order (deterministic).
+      // 1/2 .. 1/32 of their step one at a time, in vertex order (deterministic). Only
+      // inversion sends a point back: a check that also refused moves making a face's
+      // symmetric Dirichlet density pass 32 (thin faces) sent a fifth of the points back in
+      // every iteration on the TOSCA cats, cascading through their neighbours, so coherent
+      // slides stalled (issue 19: faust5k 0.034/0.071/0.035 -> 0.032/0.064/0.034 evalcorr).
       std::vector<SurfacePoint> sp_new(sp_);
       std::vector<Vec3> q_new(q_);
       for (int v = 0; v < nv; ++v) {
@@ -283,7 +287,7 @@ class MemberFit {
             const int u = t_.F(f, c);
             p[c] = back[static_cast<size_t>(u)] ? q_[static_cast<size_t>(u)] : q_new[static_cast<size_t>(u)];
           }
-          if (orient3d_origin(p[0], p[1], p[2]) > 0 && !worse_shape(static_cast<int>(f), back, sp_new)) continue;
+          if (orient3d_origin(p[0], p[1], p[2]) > 0) continue;
           for (int c = 0; c < 3; ++c) {
             const int u = t_.F(f, c);
             if (!back[static_cast<size_t>(u)] && index[static_cast<size_t>(u)] >= 0) back[static_cast<size_t>(u)] = 1, changed = true;
@@ -300,11 +304,11 @@ class MemberFit {
         const int iv = index[static_cast<size_t>(v)];
         if (iv < 0 || !back[static_cast<size_t>(v)]) continue;
         const Vec3 delta = T[static_cast<size_t>(v)] * step.segment<2>(2 * iv);
-        for (double f : {0.5, 0.25}) {
+        for (double f : {0.5, 0.25, 0.125, 0.0625, 0.03125}) {
           const Vec3 target = Y_.row(v).transpose() + f * delta;
           const SurfacePoint cand = walk_to_nearest(m_, vf_, sp_[static_cast<size_t>(v)], target);
           const Vec3 qc = sphere_point(m_, Si_, cand);
-          if (valid_at(v, qc) && shape_ok_at(v, surface_position(m_, cand))) {
+          if (valid_at(v, qc)) {
             sp_[static_cast<size_t>(v)] = cand;
             q_[static_cast<size_t>(v)] = qc;
             Y_.row(v) = surface_position(m_, cand).transpose();
@@ -313,7 +317,7 @@ class MemberFit {
         }
       }
     }
-    *e_after = sd_total();
+    *e_after = sd_total(crushed_after);
     return Status();
   }
 
@@ -329,16 +333,25 @@ class MemberFit {
     }
     return metric_.rest_area[static_cast<size_t>(f)] * sd_density(f, p);
   }
-  double sd_total() const {
+  // Area-weighted mean over the faces not crushed: a face over a member's hole pressed onto
+  // its rim has infinite energy, and the fit lets a face's image thin out (only inversions
+  // are refused), so a face squeezed below about 1/10 of its size across some direction or
+  // stretched 10x along one (density above kCrushedDensity) is left out and counted
+  // instead: the report stays a number and measures the bulk of the surface.
+  static constexpr double kCrushedDensity = 100;
+  double sd_total(int* crushed = nullptr) const {
     double e = 0, a = 0;
+    int n = 0;
     for (Eigen::Index f = 0; f < t_.F.rows(); ++f) {
-      // A crushed face (a template face over a member's hole, pressed onto its rim) has
-      // infinite energy; it is left out, so the report stays a number (JSON has no inf).
       const double ef = sd_face(static_cast<int>(f), -1, Vec3::Zero());
-      if (!std::isfinite(ef)) continue;
+      if (!(ef <= kCrushedDensity * metric_.rest_area[static_cast<size_t>(f)])) {
+        ++n;
+        continue;
+      }
       e += ef;
       a += metric_.rest_area[static_cast<size_t>(f)];
     }
+    if (crushed) *crushed = n;
     return a > 0 ? e / a : 0.0;
   }
 
@@ -367,10 +380,8 @@ class MemberFit {
     }
   }
 
-  // A face's shape after a joint move is refused when its symmetric Dirichlet density
-  // passes kShapeCap and its value before (the rigidity step has no barrier against
-  // collapse; a nearly collapsed face makes the composed map nearly singular there).
-  static constexpr double kShapeCap = 32;
+  // Symmetric Dirichlet density of template face f's image p: tr(G) + tr(G^-1) of the image
+  // metric G in the face's rest frame (4 for an isometry, infinite for a crushed image).
   double sd_density(int f, const Vec3* p) const {
     const Eigen::Matrix2d& Gi = metric_.rest_inv[static_cast<size_t>(f)];
     const Vec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
@@ -381,31 +392,6 @@ class MemberFit {
     const double t = (Gi * Gy).trace();
     return t + t / d;
   }
-  bool worse_shape(int f, const std::vector<char>& back, const std::vector<SurfacePoint>& sp_new) const {
-    Vec3 before[3], after[3];
-    for (int c = 0; c < 3; ++c) {
-      const int u = t_.F(f, c);
-      before[c] = Y_.row(u).transpose();
-      after[c] = back[static_cast<size_t>(u)] ? before[c] : surface_position(m_, sp_new[static_cast<size_t>(u)]);
-    }
-    const double a = sd_density(f, after);
-    return a > kShapeCap && a > sd_density(f, before);
-  }
-  bool shape_ok_at(int v, const Vec3& y) const {
-    for (int k = metric_.faces.start[static_cast<size_t>(v)]; k < metric_.faces.start[static_cast<size_t>(v) + 1]; ++k) {
-      const int f = metric_.faces.face[static_cast<size_t>(k)];
-      Vec3 before[3], after[3];
-      for (int c = 0; c < 3; ++c) {
-        const int u = t_.F(f, c);
-        before[c] = Y_.row(u).transpose();
-        after[c] = u == v ? y : before[c];
-      }
-      const double a = sd_density(f, after);
-      if (a > kShapeCap && a > sd_density(f, before)) return false;
-    }
-    return true;
-  }
-
   // Orthonormal basis of the plane of member face f.
   Eigen::Matrix<double, 3, 2> tangent_basis(int f) const {
     const Vec3 a = m_.V.row(m_.F(f, 0)).transpose(), b = m_.V.row(m_.F(f, 1)).transpose(),
@@ -602,12 +588,13 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
         for (int round = 0; round < options.rounds; ++round) {
           MemberFit fit(tmpl, St, metric, features[static_cast<size_t>(t)], mi, mi_faces, cur, fi, options);
           double e0 = 0, e1 = 0;
-          SPHEREKIT_RETURN_IF_ERROR(fit.run(keep_going, &e0, &e1));
+          int crushed = 0;
+          SPHEREKIT_RETURN_IF_ERROR(fit.run(keep_going, &e0, &e1, &crushed));
           if (round == 0) rep.energy_before = rep.energy_after = e0;
           RowMat3d Q(St.rows(), 3);
           for (Eigen::Index v = 0; v < St.rows(); ++v) Q.row(v) = fit.q()[static_cast<size_t>(v)].transpose();
           // The fitted correspondence, exact but rough at the template's triangle scale
-          // (each point is stopped where a move would invert or collapse a face), is taken
+          // (each point is stopped where a move would invert a face), is taken
           // at well-spread samples only, and the member's map flows onto those targets
           // smoothly (the feature warp: compactly supported radial-basis flow, every step
           // checked with the exact predicate), the features standing still. A flow that
@@ -665,6 +652,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           rep.rounds = round + 1;
           rep.samples = samples;
           rep.energy_after = e1;
+          rep.crushed_faces = crushed;
           rep.efficiency_after = m1.efficiency;
         }
         if (rep.refined) refined[static_cast<size_t>(i)] = std::move(cur);

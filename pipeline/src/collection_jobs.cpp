@@ -176,6 +176,7 @@ Json refinement_json(const RefinedMember& m) {
   j["samples"] = m.samples;
   j["energy_before"] = m.energy_before;
   j["energy_after"] = m.energy_after;
+  j["crushed_faces"] = m.crushed_faces;
   j["efficiency_before"] = m.efficiency_before;
   j["efficiency_after"] = m.efficiency_after;
   return j;

@@ -12,11 +12,11 @@
 //     rotations per vertex, then one Levenberg-damped Gauss-Newton step with every point
 //     moving in the tangent plane of member i's surface, then each point walks on the
 //     surface to the point nearest its stepped position. All points move at once; the
-//     points of a template face that would be inverted on the sphere (exact predicate) or
-//     collapse on the surface go back, so q always describes a bijection psi of the sphere
+//     points of a template face that would be inverted on the sphere (exact predicate) go
+//     back, so q always describes a bijection psi of the sphere
 //     (template faces carried from their own sphere triangles to q); features stay fixed;
 //   - flow: the fitted correspondence is exact but rough at the template's triangle scale
-//     (points stop where a move would invert or collapse a face), and psi^-1 composed with
+//     (points stop where a move would invert a face), and psi^-1 composed with
 //     member i's map inherits that roughness as stretch. So psi^-1 is taken only at a few
 //     hundred well-spread member vertices, and member i's map flows onto those targets with
 //     the constrained stage's feature warp (smooth compactly supported radial-basis flow,
@@ -70,8 +70,11 @@ struct RefinedMember {
   /// Distortion of the template carried onto this member: the area-weighted mean symmetric
   /// Dirichlet energy of the template's faces (4 for an isometry; it grows without bound as
   /// a face collapses), before the first round and after the last round taken; crushed
-  /// faces (template faces over a member's hole) are left out.
+  /// faces (over a member's hole, or squeezed below about 1/10 of their size across some
+  /// direction or stretched 10x along one: density above 100) are left out and counted in
+  /// crushed_faces.
   double energy_before = 0, energy_after = 0;
+  int crushed_faces = 0;  ///< template faces left out of energy_after
   int rounds = 0;        ///< fit-and-flow rounds taken
   int samples = 0;       ///< samples of the last round taken
   /// Stretch efficiency of the member's map before and after (metrics.h). A round that

@@ -36,6 +36,22 @@ SphereState make_state(const TriMesh& m, const RowMat3d& S, const RowMatXd& P) {
   return st;
 }
 
+// A capsule 4x as long as wide, its vertices projected radially onto the sphere: a valid
+// map far from the stretch optimum, so a pass has many rounds of work.
+struct RadialCapsule {
+  TriMesh m;
+  RowMat3d S0;
+  RowMatXd P;
+};
+RadialCapsule radial_capsule() {
+  RadialCapsule c{test::elongated(3, 4.0), {}, {}};
+  c.S0 = c.m.V;
+  c.S0.rowwise().normalize();
+  REQUIRE(count_flipped_faces(c.m.F, c.S0) == 0);
+  c.P = c.m.V;
+  return c;
+}
+
 double vertex_energy(const SphereState& st, int v, double reg, double split) {
   RingScratch ring;
   REQUIRE(load_ring(st, v, ring));
@@ -266,13 +282,10 @@ TEST_CASE("a ring read through the pass's ring index is the ring read from the f
 
 TEST_CASE("a pass over its work bound ends early, at the same round for any thread count, and fails the stage",
           "[param][sphere][energy]") {
-  // A capsule 4x as long as wide, its vertices projected radially onto the sphere: a valid
-  // map far from the stretch optimum, so a pass has many rounds of work.
-  const TriMesh m = test::elongated(3, 4.0);
-  RowMat3d S0 = m.V;
-  S0.rowwise().normalize();
-  REQUIRE(count_flipped_faces(m.F, S0) == 0);
-  const RowMatXd P = m.V;
+  const RadialCapsule c = radial_capsule();
+  const TriMesh& m = c.m;
+  const RowMat3d& S0 = c.S0;
+  const RowMatXd& P = c.P;
   OptimizerSettings s = settings_for_effort(2);
   auto run_pass = [&](double max_work, int threads, bool* exceeded, RowMat3d* out) {
     SphereState st = make_state(m, S0, P);
@@ -322,11 +335,10 @@ TEST_CASE("passes that share the level's ring index give the maps of passes that
   // The refiner builds a level's ring index once for all its passes (the connectivity does
   // not change between them); the maps must be those of passes that each build their own,
   // for any thread count.
-  const TriMesh m = test::elongated(3, 4.0);
-  RowMat3d S0 = m.V;
-  S0.rowwise().normalize();
-  REQUIRE(count_flipped_faces(m.F, S0) == 0);
-  const RowMatXd P = m.V;
+  const RadialCapsule c = radial_capsule();
+  const TriMesh& m = c.m;
+  const RowMat3d& S0 = c.S0;
+  const RowMatXd& P = c.P;
   const OptimizerSettings s = settings_for_effort(2);
   auto two_passes = [&](int threads, bool share) {
     SphereState st = make_state(m, S0, P);

@@ -33,7 +33,10 @@ struct SphereState {
   std::vector<double> average_face_area;  ///< per model: model_area / alive faces
   std::vector<double> model_scale;    ///< per model: 4 pi / model_area (surface rescaled to the sphere's area)
 
-  double hole_area_penalty = 0;       ///< lambda per unit chord area of real faces (meshes with holes)
+  double hole_area_penalty = 0;       ///< lambda per unit chord area of real faces (see update_hole_area_penalty)
+  /// The penalty also without holes: the full-resolution pass, whose energy is the measured
+  /// one, set by the refiner (see update_hole_area_penalty).
+  bool chord_area_penalty = false;
   /// Anti-cruft term: mean over the three edge frames (true) or w * g^-3 with g the smallest
   /// squared singular value (false); see stretch_optimizer.cpp.
   bool edge_frame_cruft = true;
@@ -79,6 +82,9 @@ struct OptimizerSettings {
   double max_pass_work = 0;
   bool coloured_rounds = false;  ///< rounds as colour classes (every computed move applied) instead of one greedy independent set
   bool edge_frame_cruft = true;  ///< SphereState::edge_frame_cruft for this stage (the collection stages set false)
+  /// The full-resolution pass minimizes the measured stretch, normalized by the chord area
+  /// the faces cover (SphereState::chord_area_penalty), also on meshes without holes.
+  bool measured_normalization = false;
 };
 
 OptimizerSettings settings_for_effort(int effort);

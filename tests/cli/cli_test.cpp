@@ -468,6 +468,31 @@ TEST_CASE("run maps given meshes and reports failures but keeps going", "[cli]")
 // The main job on the built-in samples (run without meshes) is tested with its results page
 // in site_page_test.cpp.
 
+// A child's peak memory is its own: after bench has read and measured a large mesh itself,
+// the next mesh's peak is what param measures running alone, not the bench's (a spawned
+// child's ru_maxrss includes the address space it was spawned from).
+TEST_CASE("bench: a mesh's peak memory does not include what the bench held before", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_bench_peak");
+  const std::string big = write_obj(dir, "big.obj", spherekit::test::icosphere(6));
+  const std::string small = write_obj(dir, "small.obj", spherekit::test::random_blob(2, 5));
+  const std::string out = dir + "/bench.json", alone = dir + "/alone.json";
+  CliRun r = run_cli("bench " + quote(big) + " " + quote(small) + " --effort 0 --threads 1 -o " + quote(out), dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  REQUIRE(run_cli("param " + quote(small) + " -o " + quote(dir + "/small.sphere.obj") +
+                      " --effort 0 --threads 1 --quiet --report " + quote(alone),
+                  dir)
+              .exit_code == 0);
+  const json rows = parse_json(slurp(out))["rows"];
+  REQUIRE(rows.size() == 2);
+  const double big_peak = rows[0]["peak_mb"].get<double>(), small_peak = rows[1]["peak_mb"].get<double>();
+  const double alone_peak = parse_json(slurp(alone))["peak_rss_mb"].get<double>();
+  CAPTURE(big_peak, small_peak, alone_peak);
+  CHECK(small_peak > 0);
+  CHECK(small_peak < alone_peak + 2);
+  CHECK(big_peak > small_peak + 5);
+}
+
 // bench --reference-dir runs the reference's pipeline script after ours on each mesh and
 // compares with what it measured in the same run. The stand-in "reference" here is a script
 // that runs this same spherekit (deterministic), so both rows must agree exactly; the real

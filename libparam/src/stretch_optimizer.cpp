@@ -182,7 +182,6 @@ void SphereState::update_hole_area_penalty() {
   // (Blender Skin modifier, 7.8k vertices) ended at 61.5 plain energy and chord area 13.45
   // (efficiency 0.1925) where the reference's map has 64.2 and 12.70 (0.1955).
   hole_area_penalty = 0;
-  if (face_shape_weight.empty() && !chord_area_penalty) return;
   bool holes = false;
   for (size_t f = 0; f < face_shape_weight.size() && !holes; ++f) holes = face_alive[f] && face_shape_weight[f] > 0;
   if (!holes && !chord_area_penalty) return;

@@ -626,7 +626,7 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
   const Member& rm = mem[ref];
   const int kr = static_cast<int>(rm.ext.size());
   const double pairs = kr * (kr + 1) / 2.0;
-  SphereParamOptions so;
+  SphereParamOptions so = collection_sphere_options();
   so.effort = o.sphere_effort;
   so.threads = o.threads;
   auto base = parameterize_sphere(meshes[ref], so);
@@ -755,7 +755,7 @@ bool repin_maps(const std::vector<TriMesh>& meshes, const std::vector<Member>& m
                 const ProgressFn& progress) {
   if (std::find(unpinned.begin(), unpinned.end(), 1) == unpinned.end()) return true;
   if (ma.maps.size() != meshes.size() || ma.maps[ref].rows() == 0) return true;
-  SphereParamOptions so;
+  SphereParamOptions so = collection_sphere_options();
   so.effort = o.sphere_effort;
   so.threads = o.threads;
   const RowMat3d& S_ref = ma.maps[ref];

@@ -485,7 +485,8 @@ Result<bool> polish_stretch(const Result<FilledMesh>& closed, const std::vector<
     if (!(mean.norm() > 0) || !detail::kernel_point(Sc, rings[static_cast<size_t>(h)], mean, &x)) return false;
     Sc.row(filled.original_vertices + h) = x.transpose();
   }
-  const SphereParamOptions so;  // the unconstrained stage's defaults: weights, effort preset
+  // The unconstrained stage's hole weights and effort preset, the collection stages' anti-cruft weight.
+  const SphereParamOptions so = collection_sphere_options();
   detail::OptimizerSettings settings = detail::optimizer_settings(so);
   settings.final_iter = passes;
   settings.threads = 1;  // members are refined in parallel

@@ -139,7 +139,7 @@ void bind_param(pyb::module_& m) {
       [](const Mesh& mesh, std::vector<int> feature_vertices, const pyb::array& targets, int effort, std::uint64_t seed,
          int threads, Callback progress) {
         ConstrainedParamOptions o;
-        o.sphere = sphere_options(effort, seed, threads, SphereParamOptions{}.regularizer_weight);
+        o.sphere = sphere_options(effort, seed, threads, kCollectionRegularizerWeight);
         const std::vector<Eigen::Vector3d> t = to_points(targets, "targets");
         return run_stage(std::move(progress), mesh.source, [&](const ProgressFn& fn) {
           return parameterize_sphere_constrained(mesh.mesh, feature_vertices, t, o, fn);
@@ -186,7 +186,7 @@ void bind_param(pyb::module_& m) {
          bool refine_locations, bool refine_correspondence, int effort, std::uint64_t seed, int threads,
          Callback progress) {
         ConsistentParamOptions o;
-        o.constrained.sphere = sphere_options(effort, seed, threads, SphereParamOptions{}.regularizer_weight);
+        o.constrained.sphere = sphere_options(effort, seed, threads, kCollectionRegularizerWeight);
         o.reference = reference;
         o.remesh_size = remesh_size;
         o.refine_locations = refine_locations;

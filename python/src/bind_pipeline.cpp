@@ -15,8 +15,9 @@ using Callback = std::optional<pyb::function>;
 // nlohmann JSON -> Python objects, through the json module (reports are small).
 pyb::object to_python(const pipeline::Json& j) { return pyb::module_::import("json").attr("loads")(j.dump()); }
 
+// A collection's sphere options: the collection stages' anti-cruft weight.
 SphereParamOptions sphere_defaults(int effort, std::uint64_t seed, int threads) {
-  SphereParamOptions o;
+  SphereParamOptions o = collection_sphere_options();
   o.effort = effort;
   o.seed = seed;
   o.threads = threads;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cli_runner.h"
+#include "spherekit/sphere_param.h"
 #include "spherekit/version.h"
 #include "test_meshes.h"
 #include "test_paths.h"
@@ -355,6 +356,46 @@ TEST_CASE("param writes a bijective unit sphere map and eval agrees", "[cli]") {
   CliRun mismatch = run_cli("eval " + quote(other) + " " + quote(sphere), dir);
   CHECK(mismatch.exit_code == 3);
   require_one_line_error(mismatch, sphere);
+}
+
+TEST_CASE("param: a constrained map takes the collection stages' anti-cruft weight unless the flag is given",
+          "[cli]") {
+  // The unconstrained map's default weight is lower (sphere_param.h); a constrained map is the
+  // map `consistent` or `add` would make, so `param --features` keeps theirs.
+  const std::string dir = spherekit::test::temp_dir("cli_param_regularizer");
+  const TriMesh blob = spherekit::test::random_blob(2, 11);
+  const std::string mesh = write_obj(dir, "blob.obj", blob);
+  // Four features: the vertices farthest out towards a regular tetrahedron's corners.
+  const double k = 1.0 / std::sqrt(3.0);
+  const Eigen::Vector3d corners[4] = {{k, k, k}, {k, -k, -k}, {-k, k, -k}, {-k, -k, k}};
+  std::string features, targets;
+  for (int c = 0; c < 4; ++c) {
+    Eigen::Index best = 0;
+    double best_dot = -2;
+    for (Eigen::Index v = 0; v < blob.V.rows(); ++v) {
+      const double d = blob.V.row(v).normalized().dot(corners[c].transpose());
+      if (d > best_dot) best_dot = d, best = v;
+    }
+    features += "f" + std::to_string(c) + " " + std::to_string(best) + "\n";
+    char line[160];
+    std::snprintf(line, sizeof line, "f%d %.17g %.17g %.17g\n", c, corners[c].x(), corners[c].y(), corners[c].z());
+    targets += line;
+  }
+  write_text(dir + "/blob.lm.txt", features);
+  write_text(dir + "/blob.targets.txt", targets);
+  auto weight = [&](const std::string& extra) {
+    const std::string report = dir + "/r.json";
+    CliRun p = run_cli("param " + quote(mesh) + " -o " + quote(dir + "/blob.sphere.obj") + " --report " + quote(report) +
+                           " --effort 0 --quiet" + extra, dir);
+    INFO("stderr: " << p.err);
+    REQUIRE(p.exit_code == 0);
+    return parse_json(slurp(report))["options"]["regularizer_weight"].get<double>();
+  };
+  const std::string constrained = " --features " + quote(dir + "/blob.lm.txt") + " --targets " + quote(dir + "/blob.targets.txt");
+  CHECK(weight("") == spherekit::SphereParamOptions{}.regularizer_weight);
+  CHECK(weight(constrained) == spherekit::kCollectionRegularizerWeight);
+  CHECK(weight(constrained + " --regularizer-weight 2e-5") == 2e-5);
+  CHECK(weight(" --regularizer-weight 3e-4") == 3e-4);
 }
 
 TEST_CASE("param checks every output folder before writing anything", "[cli]") {

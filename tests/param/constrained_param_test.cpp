@@ -369,7 +369,7 @@ TEST_CASE("a twisted thin finger provokes a swirl, which the avoidance heuristic
     fv.push_back(nearest_vertex(m, d));
   // Targets: the unconstrained map's feature images, with the tip ring turned by 150
   // degrees about the tip's image: the map must twist the finger by that much.
-  SphereParamOptions uo;
+  SphereParamOptions uo = collection_sphere_options();  // as the collection stages make their maps
   uo.threads = 1;
   auto u = parameterize_sphere(m, uo);
   REQUIRE(u.ok());
@@ -452,7 +452,7 @@ TEST_CASE("a dense feature set (64 features) gets a bijective map through the fe
   TriMesh m = test::random_blob(4, 3);
   const int k = 64;
   std::vector<int> fv = farthest_point_features(m, k);
-  SphereParamOptions uo;
+  SphereParamOptions uo = collection_sphere_options();  // as the collection stages make their maps
   uo.threads = 1;
   auto u = parameterize_sphere(m, uo);
   REQUIRE(u.ok());

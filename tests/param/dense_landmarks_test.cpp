@@ -124,7 +124,7 @@ TEST_CASE("feature warp: where a feature passes close by another, the relaxation
   // relaxation the warp gives up; with it (one stretch pass, features held) it completes,
   // bijective, every feature exact.
   const TriMesh m = test::random_blob(3, 11);
-  SphereParamOptions uo;
+  SphereParamOptions uo = collection_sphere_options();  // as the collection stages make their maps
   uo.effort = 0;
   auto u = parameterize_sphere(m, uo);
   REQUIRE(u.ok());
@@ -189,7 +189,7 @@ namespace {
 // k farthest-point landmarks of m, and m's unconstrained map at effort 0 in *S (where the
 // targets are made from).
 std::vector<int> unconstrained_map_and_landmarks(const TriMesh& m, int k, RowMat3d* S) {
-  SphereParamOptions uo;
+  SphereParamOptions uo = collection_sphere_options();  // as the collection stages make their maps
   uo.effort = 0;
   auto u = parameterize_sphere(m, uo);
   REQUIRE(u.ok());

@@ -20,7 +20,7 @@ struct ConsistentArgs {
   pipeline::MakeCollectionJob job;
   std::string report;
   bool quiet = false;
-  SphereParamOptions sphere;
+  SphereParamOptions sphere = collection_sphere_options();
   ConstrainedFlags flags;
 };
 
@@ -68,7 +68,7 @@ struct AddArgs {
   pipeline::AddToCollectionJob job;
   std::string report;
   bool quiet = false;
-  SphereParamOptions sphere;
+  SphereParamOptions sphere = collection_sphere_options();
   ConstrainedFlags flags;
 };
 

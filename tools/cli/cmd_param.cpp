@@ -17,6 +17,7 @@ struct ParamArgs {
   std::string report;
   bool quiet = false;
   ConstrainedFlags flags;
+  bool regularizer_given = false;  // --regularizer-weight on the command line
 };
 
 void print_summary(const pipeline::ParamResult& p) {
@@ -50,6 +51,9 @@ int run_param(const ParamArgs& a) {
   if (Status s = require_output_folders({a.job.output, a.report, a.job.dump_network}); !s.ok()) return print_error(s);
   pipeline::ParamJob job = a.job;
   job.constrained = a.flags.constrained;
+  // A constrained map is a collection stage's map (one `consistent` or `add` would make):
+  // it takes the collection stages' anti-cruft weight unless the flag says otherwise.
+  if (!job.features.empty() && !a.regularizer_given) job.options.regularizer_weight = kCollectionRegularizerWeight;
   ProgressRenderer progress(a.quiet);
   auto r = [&] {
     ComputeScope graceful_cancel;
@@ -97,7 +101,10 @@ void register_param(CLI::App& app) {
   cmd->add_option("--targets", args->job.targets, "their sphere points (`name x y z` unit vectors)");
   cmd->add_option("--dump-network", args->job.dump_network, "write the path network here (.obj polylines)");
   add_constrained_flags(*cmd, args->flags);
-  cmd->callback([args] { set_exit_code(run_param(*args)); });
+  cmd->callback([args, cmd] {
+    args->regularizer_given = cmd->count("--regularizer-weight") + cmd->count("--regularizer_weight") > 0;
+    set_exit_code(run_param(*args));
+  });
 }
 
 }  // namespace spherekit::cli

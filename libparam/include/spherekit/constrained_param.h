@@ -18,8 +18,8 @@ namespace spherekit {
 
 struct ConstrainedParamOptions {
   /// Stretch optimizer settings (shared with the unconstrained stage; align_rotation is
-  /// ignored: the targets fix the orientation).
-  SphereParamOptions sphere;
+  /// ignored: the targets fix the orientation); the collection stages' anti-cruft weight.
+  SphereParamOptions sphere = collection_sphere_options();
   // Path network (§4, §4.1). Shape-defining.
   double steiner_penalty = 2.0;     ///< cost factor of paths through edge midpoints
   double min_angle_deg = 10.0;      ///< arcs making smaller angles are inserted last

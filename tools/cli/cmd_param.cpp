@@ -101,6 +101,9 @@ void register_param(CLI::App& app) {
   cmd->add_option("--targets", args->job.targets, "their sphere points (`name x y z` unit vectors)");
   cmd->add_option("--dump-network", args->job.dump_network, "write the path network here (.obj polylines)");
   add_constrained_flags(*cmd, args->flags);
+  cmd->get_option("--regularizer-weight")
+      ->description("weight of the term against collapsed sphere triangles (shape-defining); with --features "
+                    "the collection stages' 1e-4 unless given");
   cmd->callback([args, cmd] {
     args->regularizer_given = cmd->count("--regularizer-weight") + cmd->count("--regularizer_weight") > 0;
     set_exit_code(run_param(*args));

@@ -167,6 +167,7 @@ class Refiner {
     OptimizerSettings final_settings = s_;
     final_settings.split_distance = 0.25;
     final_settings.global_iter = s_.final_iter;
+    final_settings.precise_vertices = 0;  // the coarse layout's precision (a small mesh's last level is not coarse)
     // With measured_normalization the pass minimizes the measured efficiency itself: the
     // stretch normalized by the chord area the faces cover (SphereState::chord_area_penalty).
     st_.chord_area_penalty = s_.measured_normalization;

@@ -24,7 +24,9 @@ std::string options_digest(const SphereParamOptions& o) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "reg=%.17g;hole=%.17g;hshape=%.17g;seed=%llu;effort=%d;align=%d", o.regularizer_weight, o.hole_weight, o.hole_shape_weight,
                 static_cast<unsigned long long>(o.seed), o.effort, o.align_rotation ? 1 : 0);
-  return detail::options_digest_hex(buf);
+  std::string printed = buf;
+  if (o.precise_layout) printed += ";precise";  // absent when off: the collection stages' digests are as before
+  return detail::options_digest_hex(printed);
 }
 
 // Rotation that best aligns each face's sphere direction with its surface normal (area

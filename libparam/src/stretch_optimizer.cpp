@@ -741,13 +741,20 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   // Activity threshold: absolute (the reference's movetol), or relative to the vertex's
   // shortest chord to a neighbour, so that convergence is judged at the scale of the local
   // triangles: coarse levels stop sooner, compressed regions (thin legs) are refined longer.
+  // A coarse level (precise_vertices) is judged more tightly in the first rounds of a pass
+  // (rel_tol_of_round): the precision its global layout gets is then bounded in cost.
+  const bool precise_level = s.precise_vertices > 0 && st.alive_vertices <= s.precise_vertices;
+  double rel_tol = s.movetol_rel;
+  auto rel_tol_of_round = [&](int r) {
+    return precise_level && r < s.precise_rounds ? s.precise_movetol_rel : s.movetol_rel;
+  };
   auto activity_tol = [&](int v) {
     double tol = s.movetol;
-    if (s.movetol_rel > 0) {
+    if (rel_tol > 0) {
       double shortest = kInf;
       const Eigen::Vector3d x = st.S.row(v).transpose();
       for (int w : corners(v)) shortest = std::min(shortest, (st.S.row(w).transpose() - x).norm());
-      tol = std::min(s.movetol, s.movetol_rel * shortest);
+      tol = std::min(s.movetol, rel_tol * shortest);
     }
     return tol;
   };
@@ -775,6 +782,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   if (work_exceeded) *work_exceeded = false;
   int round = 0;
   for (; round < s.max_rounds && !active.empty(); ++round) {
+    rel_tol = rel_tol_of_round(round);
     if (keep_going && !keep_going()) return -1;
     work += static_cast<double>(active.size());
     if (work_budget > 0 && work > work_budget) {

@@ -67,6 +67,7 @@ Json sphere_param_options_json(const SphereParamOptions& o) {
   j["regularizer_weight"] = o.regularizer_weight;
   j["hole_weight"] = o.hole_weight;
   j["hole_shape_weight"] = o.hole_shape_weight;
+  j["precise_layout"] = o.precise_layout;
   return j;
 }
 

@@ -330,7 +330,18 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
     cj.meshes = inputs;
     cj.features = feature_files;
     cj.output = col_dir;
-    cj.options.constrained.sphere = a.options;
+    // The collection stages' options, as `consistent` takes them (collection_sphere_options():
+    // their anti-cruft weight, no coarse-layout precision), with the run's effort, seed,
+    // threads and hole weights, and its anti-cruft weight only where the run was given one.
+    SphereParamOptions so = collection_sphere_options();
+    so.effort = a.options.effort;
+    so.seed = a.options.seed;
+    so.threads = a.options.threads;
+    so.hole_weight = a.options.hole_weight;
+    so.hole_shape_weight = a.options.hole_shape_weight;
+    so.align_rotation = a.options.align_rotation;
+    if (a.options.regularizer_weight != SphereParamOptions{}.regularizer_weight) so.regularizer_weight = a.options.regularizer_weight;
+    cj.options.constrained.sphere = so;
     cj.options.threads = a.options.threads;
     Stopwatch col_wall;
     auto made = make_collection(cj, observer.progress(""), [&] { return observer.keep_going(); });

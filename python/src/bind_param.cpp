@@ -46,6 +46,15 @@ SphereParamOptions sphere_options(int effort, std::uint64_t seed, int threads, d
   return o;
 }
 
+// The collection calls' options: collection_sphere_options() with the call's effort, seed, threads.
+SphereParamOptions collection_options(int effort, std::uint64_t seed, int threads) {
+  SphereParamOptions o = collection_sphere_options();
+  o.effort = effort;
+  o.seed = seed;
+  o.threads = threads;
+  return o;
+}
+
 std::vector<Eigen::Vector3d> to_points(const pyb::array& a, const char* what) {
   const RowMat3d m = to_rowmat3d(a, what);
   std::vector<Eigen::Vector3d> out;
@@ -139,7 +148,7 @@ void bind_param(pyb::module_& m) {
       [](const Mesh& mesh, std::vector<int> feature_vertices, const pyb::array& targets, int effort, std::uint64_t seed,
          int threads, Callback progress) {
         ConstrainedParamOptions o;
-        o.sphere = sphere_options(effort, seed, threads, kCollectionRegularizerWeight);
+        o.sphere = collection_options(effort, seed, threads);
         const std::vector<Eigen::Vector3d> t = to_points(targets, "targets");
         return run_stage(std::move(progress), mesh.source, [&](const ProgressFn& fn) {
           return parameterize_sphere_constrained(mesh.mesh, feature_vertices, t, o, fn);
@@ -186,7 +195,7 @@ void bind_param(pyb::module_& m) {
          bool refine_locations, bool refine_correspondence, int effort, std::uint64_t seed, int threads,
          Callback progress) {
         ConsistentParamOptions o;
-        o.constrained.sphere = sphere_options(effort, seed, threads, kCollectionRegularizerWeight);
+        o.constrained.sphere = collection_options(effort, seed, threads);
         o.reference = reference;
         o.remesh_size = remesh_size;
         o.refine_locations = refine_locations;

@@ -53,7 +53,9 @@ int run_param(const ParamArgs& a) {
   job.constrained = a.flags.constrained;
   // A constrained map is a collection stage's map (one `consistent` or `add` would make):
   // it takes the collection stages' anti-cruft weight unless the flag says otherwise.
+  // (and, like them, no coarse-layout precision: SphereParamOptions::precise_layout).
   if (!job.features.empty() && !a.regularizer_given) job.options.regularizer_weight = kCollectionRegularizerWeight;
+  if (!job.features.empty()) job.options.precise_layout = false;
   ProgressRenderer progress(a.quiet);
   auto r = [&] {
     ComputeScope graceful_cancel;

@@ -56,6 +56,13 @@ struct OptimizerSettings {
   int final_iter = 3;          ///< passes at full resolution (on the measured energy)
   double movetol = 1e-3;       ///< a vertex stays active while its credit exceeds this
   double movetol_rel = 0;      ///< if > 0: threshold = min(movetol, movetol_rel * shortest chord to a neighbour)
+  /// Coarse layout precision (SphereParamOptions::precise_layout): levels of at most
+  /// precise_vertices vertices (the final pass excepted) judge activity with
+  /// precise_movetol_rel instead of movetol_rel for the first precise_rounds rounds of each
+  /// pass. 0 = off.
+  int precise_vertices = 0;
+  double precise_movetol_rel = 0;
+  int precise_rounds = 0;
   double nv_ratio = 1.2;       ///< a level is optimized each time #V grows by this factor
   double regularizer_weight = 1e-4;
   /// Faces whose chord plane passes closer than this to the centre (large spherical

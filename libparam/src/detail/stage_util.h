@@ -2,6 +2,7 @@
 // shape-defining options, and the normalization of the input. Internal to libparam.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +21,12 @@ namespace spherekit::detail {
 inline OptimizerSettings optimizer_settings(const SphereParamOptions& o) {
   OptimizerSettings s = settings_for_effort(o.effort);
   s.regularizer_weight = o.regularizer_weight;
+  if (o.precise_layout && s.movetol_rel > 0) {  // SphereParamOptions::precise_layout (effort 2)
+    s.precise_vertices = 3000;
+    s.precise_movetol_rel = s.movetol_rel / 4;
+    s.precise_rounds = 10;
+    s.final_iter = std::max(s.final_iter, 3);
+  }
   s.seed = o.seed;
   s.threads = o.threads;
   return s;

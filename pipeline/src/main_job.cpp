@@ -332,13 +332,14 @@ Result<MainJobResult> run_main_job(const MainJob& a, MainJobObserver& observer) 
     cj.output = col_dir;
     // The collection stages' options, as `consistent` takes them (collection_sphere_options():
     // their anti-cruft weight, no coarse-layout precision), with the run's effort, seed,
-    // threads and hole weights, and its anti-cruft weight only where the run was given one.
+    // threads, hole weight and alignment, and its anti-cruft and hole shape weights only where
+    // the run was given other ones than param's defaults.
     SphereParamOptions so = collection_sphere_options();
     so.effort = a.options.effort;
     so.seed = a.options.seed;
     so.threads = a.options.threads;
     so.hole_weight = a.options.hole_weight;
-    so.hole_shape_weight = a.options.hole_shape_weight;
+    if (a.options.hole_shape_weight != SphereParamOptions{}.hole_shape_weight) so.hole_shape_weight = a.options.hole_shape_weight;
     so.align_rotation = a.options.align_rotation;
     if (a.options.regularizer_weight != SphereParamOptions{}.regularizer_weight) so.regularizer_weight = a.options.regularizer_weight;
     cj.options.constrained.sphere = so;

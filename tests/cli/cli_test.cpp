@@ -358,7 +358,7 @@ TEST_CASE("param writes a bijective unit sphere map and eval agrees", "[cli]") {
   require_one_line_error(mismatch, sphere);
 }
 
-TEST_CASE("param: a constrained map takes the collection stages' anti-cruft weight unless the flag is given",
+TEST_CASE("param: a constrained map takes the collection stages' anti-cruft and hole shape weights unless the flags are given",
           "[cli]") {
   // The unconstrained map's default weight is lower (sphere_param.h); a constrained map is the
   // map `consistent` or `add` would make, so `param --features` keeps theirs.
@@ -383,19 +383,27 @@ TEST_CASE("param: a constrained map takes the collection stages' anti-cruft weig
   }
   write_text(dir + "/blob.lm.txt", features);
   write_text(dir + "/blob.targets.txt", targets);
-  auto weight = [&](const std::string& extra) {
+  auto option = [&](const std::string& extra, const char* key) {
     const std::string report = dir + "/r.json";
     CliRun p = run_cli("param " + quote(mesh) + " -o " + quote(dir + "/blob.sphere.obj") + " --report " + quote(report) +
                            " --effort 0 --quiet" + extra, dir);
     INFO("stderr: " << p.err);
     REQUIRE(p.exit_code == 0);
-    return parse_json(slurp(report))["options"]["regularizer_weight"].get<double>();
+    return parse_json(slurp(report))["options"][key];
   };
+  auto weight = [&](const std::string& extra) { return option(extra, "regularizer_weight").get<double>(); };
+  auto hole_shape = [&](const std::string& extra) { return option(extra, "hole_shape_weight").get<double>(); };
   const std::string constrained = " --features " + quote(dir + "/blob.lm.txt") + " --targets " + quote(dir + "/blob.targets.txt");
   CHECK(weight("") == spherekit::SphereParamOptions{}.regularizer_weight);
   CHECK(weight(constrained) == spherekit::kCollectionRegularizerWeight);
   CHECK(weight(constrained + " --regularizer-weight 2e-5") == 2e-5);
   CHECK(weight(" --regularizer-weight 3e-4") == 3e-4);
+  // The hole faces' shape weight the same way, and the coarse-layout precision.
+  CHECK(hole_shape("") == spherekit::SphereParamOptions{}.hole_shape_weight);
+  CHECK(hole_shape(constrained) == spherekit::kCollectionHoleShapeWeight);
+  CHECK(hole_shape(constrained + " --hole-shape-weight 0.1") == 0.1);
+  CHECK(option("", "precise_layout").get<bool>());
+  CHECK_FALSE(option(constrained, "precise_layout").get<bool>());
 }
 
 TEST_CASE("param checks every output folder before writing anything", "[cli]") {

@@ -18,6 +18,7 @@ struct ParamArgs {
   bool quiet = false;
   ConstrainedFlags flags;
   bool regularizer_given = false;  // --regularizer-weight on the command line
+  bool hole_shape_given = false;   // --hole-shape-weight on the command line
 };
 
 void print_summary(const pipeline::ParamResult& p) {
@@ -52,9 +53,10 @@ int run_param(const ParamArgs& a) {
   pipeline::ParamJob job = a.job;
   job.constrained = a.flags.constrained;
   // A constrained map is a collection stage's map (one `consistent` or `add` would make):
-  // it takes the collection stages' anti-cruft weight unless the flag says otherwise.
-  // (and, like them, no coarse-layout precision: SphereParamOptions::precise_layout).
+  // it takes the collection stages' anti-cruft and hole shape weights unless the flags say
+  // otherwise (and, like them, no coarse-layout precision: SphereParamOptions::precise_layout).
   if (!job.features.empty() && !a.regularizer_given) job.options.regularizer_weight = kCollectionRegularizerWeight;
+  if (!job.features.empty() && !a.hole_shape_given) job.options.hole_shape_weight = kCollectionHoleShapeWeight;
   if (!job.features.empty()) job.options.precise_layout = false;
   ProgressRenderer progress(a.quiet);
   auto r = [&] {
@@ -106,8 +108,12 @@ void register_param(CLI::App& app) {
   cmd->get_option("--regularizer-weight")
       ->description("weight of the term against collapsed sphere triangles (shape-defining); with --features "
                     "the collection stages' 1e-4 unless given");
+  cmd->get_option("--hole-shape-weight")
+      ->description("weight of the shape term that keeps hole faces from becoming slivers (shape-defining); with "
+                    "--features the collection stages' 0.3 unless given");
   cmd->callback([args, cmd] {
     args->regularizer_given = cmd->count("--regularizer-weight") + cmd->count("--regularizer_weight") > 0;
+    args->hole_shape_given = cmd->count("--hole-shape-weight") + cmd->count("--hole_shape_weight") > 0;
     set_exit_code(run_param(*args));
   });
 }

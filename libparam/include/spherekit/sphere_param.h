@@ -37,15 +37,15 @@ struct SphereParamOptions {
   double hole_shape_weight = 0.03;
   std::uint64_t seed = 1;            ///< every random choice (line-search directions) derives from this
   bool align_rotation = true;        ///< rotate the result so face directions best match surface normals
-  /// Coarse levels decide the global layout (Praun & Hoppe 2003, §5), and the effort-2
-  /// convergence test, relative to the local chord length, stops them early: on smooth
-  /// shapes the fine levels cannot move the layout back (igea 0.96170 against the reference
-  /// implementation's 0.96176). With this set, levels of at most 3000 vertices are judged 4x
-  /// more tightly in the first 10 rounds of each pass (bounded cost; limb shapes, which
-  /// converge slowly, then go on at the usual tolerance), and the final pass makes 3 passes
-  /// instead of 2. Measured over 40 meshes of four kinds (issue 20): below the reference on
-  /// none (3 before), CPU +5% in all. The collection stages leave it off
-  /// (collection_sphere_options()): their maps were measured without it.
+  /// Coarse levels decide the global layout (Praun & Hoppe 2003 optimize coarse to fine over
+  /// the progressive mesh), and the effort-2 convergence test, relative to the local chord
+  /// length, stops them early: on smooth shapes the fine levels cannot move the layout back
+  /// (igea 0.96170 against the reference implementation's 0.96176). With this set, levels of
+  /// at most 3000 vertices are judged 4x more tightly in the first 10 rounds of each pass
+  /// (bounded cost; limb shapes, which converge slowly, then go on at the usual tolerance),
+  /// and the final pass makes 3 passes instead of 2. Measured over 40 meshes of four kinds
+  /// (issue 20): below the reference on none (3 before), CPU +5% in all. The collection
+  /// stages leave it off (collection_sphere_options()): their maps were measured without it.
   bool precise_layout = true;
   // Effort: changes only speed and accuracy.
   int effort = 2;                    ///< 0..5; expands to the presets in sphere_param.cpp

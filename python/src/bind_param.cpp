@@ -46,15 +46,6 @@ SphereParamOptions sphere_options(int effort, std::uint64_t seed, int threads, d
   return o;
 }
 
-// The collection calls' options: collection_sphere_options() with the call's effort, seed, threads.
-SphereParamOptions collection_options(int effort, std::uint64_t seed, int threads) {
-  SphereParamOptions o = collection_sphere_options();
-  o.effort = effort;
-  o.seed = seed;
-  o.threads = threads;
-  return o;
-}
-
 std::vector<Eigen::Vector3d> to_points(const pyb::array& a, const char* what) {
   const RowMat3d m = to_rowmat3d(a, what);
   std::vector<Eigen::Vector3d> out;

@@ -15,15 +15,6 @@ using Callback = std::optional<pyb::function>;
 // nlohmann JSON -> Python objects, through the json module (reports are small).
 pyb::object to_python(const pipeline::Json& j) { return pyb::module_::import("json").attr("loads")(j.dump()); }
 
-// A collection's sphere options: the collection stages' anti-cruft weight.
-SphereParamOptions sphere_defaults(int effort, std::uint64_t seed, int threads) {
-  SphereParamOptions o = collection_sphere_options();
-  o.effort = effort;
-  o.seed = seed;
-  o.threads = threads;
-  return o;
-}
-
 convert::LodMode lod_mode(const std::string& name) {
   if (name == "uniform") return convert::LodMode::Uniform;
   if (name == "adaptive") return convert::LodMode::Adaptive;
@@ -70,7 +61,7 @@ void bind_pipeline(pyb::module_& m) {
         job.features = features;
         job.output = output;
         job.reference = reference;
-        job.options.constrained.sphere = sphere_defaults(effort, seed, threads);
+        job.options.constrained.sphere = collection_options(effort, seed, threads);
         job.options.threads = threads;
         job.options.remesh_size = remesh_size;
         const pipeline::MakeCollectionResult r = run_stage(std::move(progress), "", [&](const ProgressFn& fn) {

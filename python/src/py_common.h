@@ -8,11 +8,13 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
 #include "spherekit/mesh.h"
 #include "spherekit/progress.h"
+#include "spherekit/sphere_param.h"
 #include "spherekit/status.h"
 
 namespace spherekit::py {
@@ -38,6 +40,16 @@ T unwrap(Result<T>&& r, const std::string& context = {}) {
   if (!r.ok()) throw_status(r.status(), context);
   return std::move(r).value();
 }
+// The collection calls' sphere options: collection_sphere_options() (the collection stages'
+// weights, no coarse-layout precision) with the call's effort, seed and threads.
+inline SphereParamOptions collection_options(int effort, std::uint64_t seed, int threads) {
+  SphereParamOptions o = collection_sphere_options();
+  o.effort = effort;
+  o.seed = seed;
+  o.threads = threads;
+  return o;
+}
+
 inline void check(const Status& s, const std::string& context = {}) {
   if (!s.ok()) throw_status(s, context);
 }

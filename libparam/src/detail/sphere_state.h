@@ -63,6 +63,9 @@ struct OptimizerSettings {
   int precise_vertices = 0;
   double precise_movetol_rel = 0;
   int precise_rounds = 0;
+  /// If > 0: the split_distance of the level passes above precise_vertices vertices (the
+  /// final pass keeps its own). SphereParamOptions::precise_layout sets 0.95.
+  double fine_split_distance = 0;
   double nv_ratio = 1.2;       ///< a level is optimized each time #V grows by this factor
   double regularizer_weight = 1e-4;
   /// Faces whose chord plane passes closer than this to the centre (large spherical

@@ -26,6 +26,7 @@ inline OptimizerSettings optimizer_settings(const SphereParamOptions& o) {
     s.precise_movetol_rel = s.movetol_rel / 4;
     s.precise_rounds = 10;
     s.final_iter = std::max(s.final_iter, 3);
+    s.fine_split_distance = 0.95;
   }
   s.seed = o.seed;
   s.threads = o.threads;

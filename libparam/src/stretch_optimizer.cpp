@@ -159,7 +159,7 @@ void SphereState::update_areas() {
   for (int m = 0; m < models; ++m) {
     double& a = model_area[static_cast<size_t>(m)];
     if (!(a > 0)) a = 1.0;  // a fully degenerate level (cannot happen for valid input)
-    area_floor[static_cast<size_t>(m)] = 1e-3 * a / std::max(1, alive);
+    area_floor[static_cast<size_t>(m)] = area_floor_rel * a / std::max(1, alive);
   }
   average_face_area.resize(model_area.size());
   for (size_t m = 0; m < model_area.size(); ++m) average_face_area[m] = model_area[m] / std::max(1, alive);

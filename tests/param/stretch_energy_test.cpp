@@ -443,4 +443,36 @@ TEST_CASE("a small face's accordion split measures its chord triangle's energy t
   CHECK(optimizer_settings(o).fine_split_distance == 0.95);
   CHECK(optimizer_settings(o).precise_vertices == 3000);
   CHECK(optimizer_settings(collection_sphere_options()).fine_split_distance == 0.0);
+  // Likewise the levels' area floor (3% of the mean face area); the collection stages keep
+  // the measured objective's 0.1%.
+  CHECK(optimizer_settings(o).area_floor_rel == 0.03);
+  CHECK(optimizer_settings(collection_sphere_options()).area_floor_rel == 1e-3);
+}
+
+TEST_CASE("the area floor gives faces of tiny surface area a share of the energy", "[param][sphere][energy]") {
+  // SphereState::area_floor_rel: a face's weight is its area plus that share of the mean face
+  // area. A vertex of the radial capsule with one ring face shrunk to a sliver on the surface:
+  // its energy (the sliver squeezed across on the sphere) rises with the floor, and with the
+  // measured objective's floor the sliver contributes almost nothing.
+  RadialCapsule c = radial_capsule();
+  const int v = 40;
+  SphereState st = make_state(c.m, c.S0, c.P);
+  const int f = st.vf[static_cast<size_t>(v)][0];
+  // Move the face's other two corners' surface points onto v's, nearly: a sliver of ~1e-4 of its area.
+  RowMatXd P = c.P;
+  for (int w : st.F[static_cast<size_t>(f)])
+    if (w != v) P.row(w) = P.row(v) + 1e-2 * (c.P.row(w) - c.P.row(v));
+  st.P = &P;
+  double energy[2];
+  for (int k = 0; k < 2; ++k) {
+    st.area_floor_rel = k == 0 ? 1e-3 : 0.03;
+    st.update_areas();
+    RingScratch ring;
+    REQUIRE(load_ring(st, v, ring));
+    energy[k] = ring_energy(st, ring, st.S.row(v).transpose(), 1e-4, 0.0);
+    REQUIRE(std::isfinite(energy[k]));
+  }
+  INFO("energy with floor 0.001: " << energy[0] << ", with 0.03: " << energy[1]);
+  CHECK(energy[1] > energy[0]);
+  CHECK(st.area_floor[0] == Approx(0.03 * st.average_face_area[0]));
 }

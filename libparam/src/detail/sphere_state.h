@@ -30,6 +30,8 @@ struct SphereState {
   int alive_vertices = 0;
   std::vector<double> model_area;     ///< total surface area per model at the current level
   std::vector<double> area_floor;     ///< per model: minimum energy weight area of a face
+  /// area_floor as a fraction of the mean face area (update_areas; OptimizerSettings::area_floor_rel).
+  double area_floor_rel = 1e-3;
   std::vector<double> average_face_area;  ///< per model: model_area / alive faces
   std::vector<double> model_scale;    ///< per model: 4 pi / model_area (surface rescaled to the sphere's area)
 
@@ -66,6 +68,10 @@ struct OptimizerSettings {
   /// If > 0: the split_distance of the level passes above precise_vertices vertices (the
   /// final pass keeps its own). SphereParamOptions::precise_layout sets 0.95.
   double fine_split_distance = 0;
+  /// Every face's energy weight is its surface area plus this fraction of the mean face area
+  /// (SphereState::area_floor_rel). SphereParamOptions::precise_layout sets 0.03 for the
+  /// coarse-to-fine levels; the final pass takes the default, the measured objective.
+  double area_floor_rel = 1e-3;
   double nv_ratio = 1.2;       ///< a level is optimized each time #V grows by this factor
   double regularizer_weight = 1e-4;
   /// Faces whose chord plane passes closer than this to the centre (large spherical

@@ -778,6 +778,12 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       s.max_pass_work > 0
           ? s.max_pass_work * static_cast<double>(std::max<size_t>(active.size(), kMinPassWorkVertices))
           : 0.0;
+  // A pass that has done pass_work_cap optimizations per free vertex ends there (not an
+  // error; the next level or pass goes on from its positions): see OptimizerSettings.
+  const double work_cap =
+      s.pass_work_cap > 0
+          ? s.pass_work_cap * static_cast<double>(std::max<size_t>(active.size(), kMinPassWorkVertices))
+          : 0.0;
   double work = 0;
   if (work_exceeded) *work_exceeded = false;
   int round = 0;
@@ -789,6 +795,7 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
       if (work_exceeded) *work_exceeded = true;
       break;
     }
+    if (work_cap > 0 && work > work_cap) break;
     if (s.coloured_rounds) {
       // Colour the active vertices greedily (by id, smallest colour unused by an already
       // coloured active neighbour), then run the colour classes one after another: a class

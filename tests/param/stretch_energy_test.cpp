@@ -476,3 +476,45 @@ TEST_CASE("the area floor gives faces of tiny surface area a share of the energy
   CHECK(energy[1] > energy[0]);
   CHECK(st.area_floor[0] == Approx(0.03 * st.average_face_area[0]));
 }
+
+TEST_CASE("a pass at its work cap ends there without error, at the same round for any thread count",
+          "[param][sphere][energy]") {
+  // OptimizerSettings::pass_work_cap (the unconstrained stage's 64): unlike max_pass_work the
+  // stage goes on from the positions the pass reached.
+  const RadialCapsule c = radial_capsule();
+  OptimizerSettings s = settings_for_effort(2);
+  auto run_pass = [&](double cap, int threads, bool* exceeded, RowMat3d* out) {
+    SphereState st = make_state(c.m, c.S0, c.P);
+    s.pass_work_cap = cap;
+    WorkerPool pool(threads);
+    const int rounds = optimize_all(st, s, 7, {}, &pool, exceeded);
+    *out = st.S;
+    return rounds;
+  };
+  bool full_flag = true, cut_flag = true, cut2_flag = true, loose_flag = true;
+  RowMat3d S_full, S_cut, S_cut2, S_loose;
+  const int full = run_pass(0, 1, &full_flag, &S_full);
+  const int cut = run_pass(1, 1, &cut_flag, &S_cut);  // the first round fits, the second does not
+  const int cut2 = run_pass(1, 2, &cut2_flag, &S_cut2);
+  const int loose = run_pass(100, 2, &loose_flag, &S_loose);
+  CHECK(full > 2);
+  CHECK(cut == 1);
+  CHECK(cut2 == cut);
+  CHECK(S_cut2 == S_cut);
+  CHECK(S_cut != S_full);
+  CHECK_FALSE(cut_flag);  // not the failure flag
+  CHECK_FALSE(cut2_flag);
+  CHECK(count_flipped_faces(c.m.F, S_cut) == 0);
+  CHECK(loose == full);
+  CHECK(S_loose == S_full);
+  // Through a stage it is no failure.
+  const std::vector<char> fixed(static_cast<size_t>(c.m.V.rows()), 0);
+  const std::vector<double> w(static_cast<size_t>(c.m.F.rows()), 1.0), sw(static_cast<size_t>(c.m.F.rows()), 0.0);
+  s.pass_work_cap = 1;
+  RowMat3d S = c.S0;
+  CHECK(optimize_in_place(c.P, c.m.F, w, sw, fixed, s, {}, &S).ok());
+  CHECK(count_flipped_faces(c.m.F, S) == 0);
+  // The unconstrained stage's settings set it; the collection stages do not.
+  CHECK(optimizer_settings(SphereParamOptions{}).pass_work_cap == 64);
+  CHECK(optimizer_settings(collection_sphere_options()).pass_work_cap == 0);
+}

@@ -96,6 +96,14 @@ struct OptimizerSettings {
   /// were left out (no head top, no neck corners) needed 230-520 per vertex on every pass
   /// from 700 vertices on, and had not finished after 11 CPU minutes.
   double max_pass_work = 0;
+  /// If > 0: a pass ends (without error) once it has done this many vertex optimizations per
+  /// free vertex (at least kMinPassWorkVertices vertices' worth). Normal passes of the
+  /// unconstrained stage need at most about 47 (the final pass of a generated standing figure
+  /// with holes; 28-31 elsewhere); one level of that figure at resolution 72 crept on for 419
+  /// per vertex (2000 rounds, a third of the map's CPU time) and left a worse layout than a
+  /// pass cut at 64 (issue 20: efficiency 0.1951 -> 0.2065, CPU 12.3 -> 7.6 s).
+  /// SphereParamOptions::precise_layout sets 64; the collection stages keep max_pass_work.
+  double pass_work_cap = 0;
   bool coloured_rounds = false;  ///< rounds as colour classes (every computed move applied) instead of one greedy independent set
   bool edge_frame_cruft = true;  ///< SphereState::edge_frame_cruft for this stage (the collection stages set false)
   /// The full-resolution pass minimizes the measured stretch, normalized by the chord area

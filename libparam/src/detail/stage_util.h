@@ -28,6 +28,7 @@ inline OptimizerSettings optimizer_settings(const SphereParamOptions& o) {
     s.final_iter = std::max(s.final_iter, 3);
     s.fine_split_distance = 0.95;
     s.area_floor_rel = 0.03;
+    s.pass_work_cap = 64;
   }
   s.seed = o.seed;
   s.threads = o.threads;

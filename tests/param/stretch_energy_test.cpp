@@ -53,6 +53,16 @@ RadialCapsule radial_capsule() {
   return c;
 }
 
+// One pass of optimize_all over the radial capsule from its radial map, with `threads`
+// threads; the pass's map in *out, its rounds returned.
+int capsule_pass(const RadialCapsule& c, const OptimizerSettings& s, int threads, bool* exceeded, RowMat3d* out) {
+  SphereState st = make_state(c.m, c.S0, c.P);
+  WorkerPool pool(threads);
+  const int rounds = optimize_all(st, s, 7, {}, &pool, exceeded);
+  *out = st.S;
+  return rounds;
+}
+
 double vertex_energy(const SphereState& st, int v, double reg, double split) {
   RingScratch ring;
   REQUIRE(load_ring(st, v, ring));
@@ -289,12 +299,8 @@ TEST_CASE("a pass over its work bound ends early, at the same round for any thre
   const RowMatXd& P = c.P;
   OptimizerSettings s = settings_for_effort(2);
   auto run_pass = [&](double max_work, int threads, bool* exceeded, RowMat3d* out) {
-    SphereState st = make_state(m, S0, P);
     s.max_pass_work = max_work;
-    WorkerPool pool(threads);
-    const int rounds = optimize_all(st, s, 7, {}, &pool, exceeded);
-    *out = st.S;
-    return rounds;
+    return capsule_pass(c, s, threads, exceeded, out);
   };
   bool unbounded_flag = true, bounded_flag = false, bounded_flag2 = false, loose_flag = true;
   RowMat3d S_unbounded, S_bounded, S_bounded2, S_loose;
@@ -484,12 +490,8 @@ TEST_CASE("a pass at its work cap ends there without error, at the same round fo
   const RadialCapsule c = radial_capsule();
   OptimizerSettings s = settings_for_effort(2);
   auto run_pass = [&](double cap, int threads, bool* exceeded, RowMat3d* out) {
-    SphereState st = make_state(c.m, c.S0, c.P);
     s.pass_work_cap = cap;
-    WorkerPool pool(threads);
-    const int rounds = optimize_all(st, s, 7, {}, &pool, exceeded);
-    *out = st.S;
-    return rounds;
+    return capsule_pass(c, s, threads, exceeded, out);
   };
   bool full_flag = true, cut_flag = true, cut2_flag = true, loose_flag = true;
   RowMat3d S_full, S_cut, S_cut2, S_loose;

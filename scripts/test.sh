@@ -87,16 +87,17 @@ if [[ "${SPHEREKIT_SKIP_SANITIZE:-0}" != "1" ]]; then
   # as it runs the end-to-end determinism, interrupt and application runs, the main job, the
   # npm validators, whole-collection conversion and the repeated-run determinism and effort
   # sweeps (process-level or repetition checks whose code paths the library, hostile-input and
-  # corpus tests already cover under the sanitizers; the CI has 20 minutes on 2 cores), and the
-  # 64-feature constrained map (36 s under the sanitizers; the smaller constrained and swirl
-  # tests run the same path-network and Steiner-removal code), the Blender runs (Blender is
-  # a child process; the library code they use runs under the sanitizers in the cage tests),
+  # corpus tests already cover under the sanitizers; the whole CI has 45 minutes on 2 cores),
+  # and the 64-feature constrained map (36 s under the sanitizers; the smaller constrained and
+  # swirl tests run the same path-network and Steiner-removal code), the Blender runs (Blender
+  # is a child process; the library code they use runs under the sanitizers in the cage tests),
   # the process-level scale runs of issue 23 (the Slurm cluster run, kill -9 at random
   # moments, 8 concurrent adds: 168 s under the sanitizers, 11 s in Release; the folder lock,
-  # staging and recovery they exercise have unit tests that run here), and the CLI run whose member has its nose and tail swapped (its twisted map runs
-  # the whole fallback ladder before it fails: 48 s in Release, 411 s under the sanitizers, the
-  # last test of the run; the suspect-pair check it reports runs under the sanitizers in the
-  # propose_landmarks tests and in check --landmarks' CLI test).
+  # staging and recovery they exercise have unit tests that run here), and the CLI run whose
+  # member has its nose and tail swapped (its twisted map runs the whole fallback ladder
+  # before it fails: 48 s in Release, 411 s under the sanitizers; the suspect-pair check it
+  # reports runs under the sanitizers in the propose_landmarks tests and in check
+  # --landmarks' CLI test).
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir "$root/build-asan" --output-on-failure -j2 \
       -E "shared meshes|without meshes|landmark editor|determinism:|interrupt:|transfer, morph and pca|Khronos validator|one layout for every member|effort 0 and effort 5|deterministic, also across|same bits for any thread count|dense feature set \\(64 features\\)|dense landmarks, 2 members|Blender reproduces|Slurm back end|kill -9 at 20 random moments|8 concurrent adds|nose and tail are swapped" \

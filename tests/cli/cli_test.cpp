@@ -585,6 +585,38 @@ TEST_CASE("bench compares with a reference measured in the same run", "[cli]") {
   CHECK(j["totals"]["linf_over_limit"].empty());
   CHECK(r.out.find("Linf rule (ours <= 1.5x the reference's): pass on 1 meshes") != std::string::npos);
   CHECK(r.out.find("Linf ratio") != std::string::npos);
+  // The reference's map is checked for flips by the same exact predicate as ours.
+  CHECK(row["reference"]["flipped_faces"] == 0);
+  CHECK(j["totals"]["reference_flipped_faces"] == 0);
+  CHECK(j["totals"]["reference_failed"].empty());
+  CHECK(r.out.find("reference: 0 flipped faces in its maps; failed on 0 meshes") != std::string::npos);
+
+  // A reference run that fails (SphereParam exits with an error on large generated shapes):
+  // our row is still measured and the bench succeeds; the row says how the reference's run
+  // ended, the totals name the mesh, and no reference figure enters the ratios.
+  const std::string failing = dir + "/failing_sphereparam.sh";
+  write_text(failing, "#!/bin/bash\nsleep 0.2\nexit 3\n");
+  const std::string out_failed = dir + "/bench_failed.json";
+  CliRun rf = run_cli("bench " + quote(mesh) + " --reference-dir " + quote(kit) + " --reference-script " +
+                          quote(failing) + " --threads 1 -o " + quote(out_failed),
+                      dir);
+  INFO("stderr: " << rf.err);
+  REQUIRE(rf.exit_code == 0);
+  const json jf = parse_json(slurp(out_failed));
+  const json& frow = jf["rows"][0];
+  CHECK(frow["status"] == "ok");
+  CHECK(frow["efficiency"].get<double>() == Approx(row["efficiency"].get<double>()).epsilon(1e-12));
+  REQUIRE(frow.contains("reference"));
+  CHECK(frow["reference"]["status"] == "failed");
+  CHECK(frow["reference"]["exit_code"] == 3);
+  CHECK(frow["reference"]["wall_seconds"].get<double>() >= 0.2);
+  CHECK_FALSE(frow["reference"].contains("efficiency"));
+  CHECK_FALSE(frow.contains("cpu_ratio"));
+  CHECK_FALSE(frow.contains("linf_ratio"));
+  CHECK(jf["totals"]["reference_failed"] == json::array({"blob.obj"}));
+  CHECK_FALSE(jf["totals"].contains("cpu_ratio"));
+  CHECK(rf.out.find("failed on 1 meshes (blob.obj)") != std::string::npos);
+  CHECK(rf.err.find("the reference failed on") != std::string::npos);
 
   // Without a reference measured here (the blob has no recorded figures either) our Linf is
   // still there, the reference side is left out, and our figure is the one param itself

@@ -298,8 +298,11 @@ int run_bench(const BenchArgs& a) {
   Json rows = Json::array();
   double cpu_total = 0, ref_cpu_total = 0, cpu_total_with_ref = 0, wall_total = 0;
   double worst_mb_ratio = 0, worst_eff_delta = 1e300, worst_linf_ratio = 0;
-  int worst = 0, failed = 0, flipped_total = 0, linf_compared = 0;
+  int worst = 0, failed = 0, flipped_total = 0, linf_compared = 0, reference_flipped_total = 0;
   Json linf_over = Json::array();  // meshes whose Linf ratio breaks the rule
+  // Meshes on which the reference's script failed (no map), with how long it ran: on large
+  // generated shapes SphereParam exits with an error after minutes (README, large meshes).
+  Json reference_failed = Json::array();
   for (size_t i = 0; i < meshes.size(); ++i) {
     const std::string& mesh = meshes[i];
     const std::string sphere = (work / (std::to_string(i) + ".sphere.obj")).string();
@@ -319,6 +322,8 @@ int run_bench(const BenchArgs& a) {
     const Reference* ref = find_reference(mesh);
     Reference measured{};
     std::optional<double> ref_linf;  // only measured in this run: EVALUATION.md records none
+    std::optional<int> ref_flipped;  // likewise
+    Json ref_failure;                // the reference's run when it produced no map
     if (kit) {
       // Measured side by side: replaces the recorded figures for this mesh.
       if (!surface.ok()) return print_error(with_file(surface.status(), mesh));
@@ -331,12 +336,22 @@ int run_bench(const BenchArgs& a) {
         measured = Reference{"", r->map.efficiency, r->run.cpu_seconds, r->run.peak_mb};
         ref = &measured;
         ref_linf = r->map.linf;
+        ref_flipped = r->map.flipped;
       } else {
-        std::fprintf(stderr, "[bench] the reference failed on %s (exit %d)\n", mesh.c_str(), r->run.exit_code);
+        std::fprintf(stderr, "[bench] the reference failed on %s (exit %d after %.0f s)\n", mesh.c_str(),
+                     r->run.exit_code, r->run.wall_seconds);
+        ref_failure = Json{{"status", "failed"},
+                           {"exit_code", r->run.exit_code},
+                           {"cpu_seconds", r->run.cpu_seconds},
+                           {"wall_seconds", r->run.wall_seconds},
+                           {"peak_mb", r->run.peak_mb}};
+        reference_failed.push_back(file_name(mesh));
       }
     }
     Json row{{"mesh", mesh}, {"exit_code", c.exit_code}, {"cpu_seconds", c.cpu_seconds},
              {"wall_seconds", c.wall_seconds}, {"peak_mb", c.peak_mb}};
+    if (!ref_failure.is_null()) row["reference"] = ref_failure;
+    const std::string ref_eff_cell = ref ? format_text("%.4f", ref->efficiency) : ref_failure.is_null() ? "-" : "failed";
     cpu_total += c.cpu_seconds;
     wall_total += c.wall_seconds;
 
@@ -357,7 +372,7 @@ int run_bench(const BenchArgs& a) {
       ++failed;
       worst = worse_exit_code(worst, c.exit_code != 0 ? c.exit_code : error_code_exit_code(ErrorCode::Internal));
       row["status"] = "failed";
-      table.add_row({file_name(mesh), "", "", "", ref ? format_text("%.4f", ref->efficiency) : "-", "", "",
+      table.add_row({file_name(mesh), "", "", "", ref_eff_cell, "", "",
                      ref_linf ? format_text("%.2f", *ref_linf) : "-", "", "", format_text("%.1f", c.cpu_seconds),
                      ref ? format_text("%.1f", ref->cpu_seconds) : "-", "", format_text("%.1f", c.wall_seconds),
                      format_text("%.0f", c.peak_mb), ref ? format_text("%.0f", ref->peak_mb) : "-", "",
@@ -392,6 +407,10 @@ int run_bench(const BenchArgs& a) {
       worst_mb_ratio = std::max(worst_mb_ratio, c.peak_mb / ref->peak_mb);
       worst_eff_delta = std::min(worst_eff_delta, eff - ref->efficiency);
     }
+    if (ref_flipped) {
+      row["reference"]["flipped_faces"] = *ref_flipped;
+      reference_flipped_total += std::max(0, *ref_flipped);
+    }
     if (ref_linf) {
       const double linf_ratio = ours->linf / *ref_linf;
       row["reference"]["linf"] = *ref_linf;
@@ -401,7 +420,7 @@ int run_bench(const BenchArgs& a) {
       if (!(linf_ratio <= kLinfRatioLimit)) linf_over.push_back(file_name(mesh));
     }
     table.add_row({file_name(mesh), std::to_string(report.value("V", 0)), std::to_string(report.value("F", 0)),
-                   format_text("%.4f", eff), ref ? format_text("%.4f", ref->efficiency) : "-",
+                   format_text("%.4f", eff), ref_eff_cell,
                    ref ? format_text("%+.4f", eff - ref->efficiency) : "-", format_text("%.2f", ours->linf),
                    ref_linf ? format_text("%.2f", *ref_linf) : "-", ref_linf ? ratio(ours->linf, *ref_linf) : "-",
                    std::to_string(flips), format_text("%.2f", c.cpu_seconds),
@@ -420,6 +439,12 @@ int run_bench(const BenchArgs& a) {
                 "%+.4f, worst memory ratio %.2f",
                 cpu_total_with_ref, ref_cpu_total, cpu_total_with_ref / ref_cpu_total, worst_eff_delta, worst_mb_ratio);
   std::printf("\n%d failed, %d flipped faces in total\n", failed, flipped_total);
+  if (kit) {
+    std::string names;
+    for (const Json& name : reference_failed) names += (names.empty() ? "" : ", ") + name.get<std::string>();
+    std::printf("reference: %d flipped faces in its maps; failed on %zu meshes%s\n", reference_flipped_total,
+                reference_failed.size(), names.empty() ? "" : (" (" + names + ")").c_str());
+  }
   if (linf_compared > 0) {
     std::string over;
     for (const Json& name : linf_over) over += (over.empty() ? "" : ", ") + name.get<std::string>();
@@ -444,6 +469,10 @@ int run_bench(const BenchArgs& a) {
       totals["cpu_ratio"] = cpu_total_with_ref / ref_cpu_total;
       totals["worst_efficiency_delta"] = worst_eff_delta;
       totals["worst_peak_mb_ratio"] = worst_mb_ratio;
+    }
+    if (kit) {
+      totals["reference_flipped_faces"] = reference_flipped_total;
+      totals["reference_failed"] = std::move(reference_failed);
     }
     if (linf_compared > 0) {
       totals["linf_compared"] = linf_compared;
@@ -470,8 +499,9 @@ void register_bench(CLI::App& app) {
       "CPU and wall seconds and peak MB, with the reference implementation's figures and the\n"
       "ratios ours/reference: measured in the same run with --reference-dir (alternating ours and\n"
       "its runs mesh by mesh; both maps' Linf by the same evaluator, with a pass/fail line for\n"
-      "Linf <= 1.5x the reference's), else the figures recorded in EVALUATION.md §4 on another\n"
-      "machine (no Linf there). Default meshes: the dev meshes (knight ... igea.ply) found in\n"
+      "Linf <= 1.5x the reference's; its maps' flipped faces; a mesh it fails on is listed with\n"
+      "how long it ran), else the figures recorded in EVALUATION.md §4 on another machine (no\n"
+      "Linf there). Default meshes: the dev meshes (knight ... igea.ply) found in\n"
       "--meshes-dir, else in $SPHEREKIT_SHARED_DIR/meshes or a shared/meshes folder above the\n"
       "working directory or the executable; else the built-in samples.",
       "  spherekit bench -o bench.json\n"

@@ -774,16 +774,14 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
   };
   // The work budget counts the vertex optimizations of the rounds (the active vertices), which
   // do not depend on the thread count: the pass ends at the same round for any count.
-  const double work_budget =
-      s.max_pass_work > 0
-          ? s.max_pass_work * static_cast<double>(std::max<size_t>(active.size(), kMinPassWorkVertices))
-          : 0.0;
+  auto pass_work = [&](double per_vertex) {  // 0: unbounded
+    return per_vertex > 0 ? per_vertex * static_cast<double>(std::max<size_t>(active.size(), kMinPassWorkVertices))
+                          : 0.0;
+  };
+  const double work_budget = pass_work(s.max_pass_work);
   // A pass that has done pass_work_cap optimizations per free vertex ends there (not an
   // error; the next level or pass goes on from its positions): see OptimizerSettings.
-  const double work_cap =
-      s.pass_work_cap > 0
-          ? s.pass_work_cap * static_cast<double>(std::max<size_t>(active.size(), kMinPassWorkVertices))
-          : 0.0;
+  const double work_cap = pass_work(s.pass_work_cap);
   double work = 0;
   if (work_exceeded) *work_exceeded = false;
   int round = 0;

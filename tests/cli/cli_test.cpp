@@ -555,10 +555,14 @@ TEST_CASE("bench compares with a reference measured in the same run", "[cli]") {
   const std::string script = dir + "/fake_sphereparam.sh";
   write_text(script, "#!/bin/bash\n[[ -n $MPL_ROOT && -n $OMP_NUM_THREADS ]] || exit 9\nexec " +
                          quote(SPHEREKIT_EXE) + " param \"$1\" -o \"$2\" --quiet\n");
+  // bench of the blob against the stand-in reference `ref_script`, JSON to `json_out`.
+  auto bench_against = [&](const std::string& ref_script, const std::string& json_out) {
+    return run_cli("bench " + quote(mesh) + " --reference-dir " + quote(kit) + " --reference-script " +
+                       quote(ref_script) + " --threads 1 -o " + quote(json_out),
+                   dir);
+  };
   const std::string out = dir + "/bench.json";
-  CliRun r = run_cli("bench " + quote(mesh) + " --reference-dir " + quote(kit) + " --reference-script " +
-                         quote(script) + " --threads 1 -o " + quote(out),
-                     dir);
+  CliRun r = bench_against(script, out);
   INFO("stderr: " << r.err);
   REQUIRE(r.exit_code == 0);
   CHECK(r.out.find("measured in this run") != std::string::npos);
@@ -597,9 +601,7 @@ TEST_CASE("bench compares with a reference measured in the same run", "[cli]") {
   const std::string failing = dir + "/failing_sphereparam.sh";
   write_text(failing, "#!/bin/bash\nsleep 0.2\nexit 3\n");
   const std::string out_failed = dir + "/bench_failed.json";
-  CliRun rf = run_cli("bench " + quote(mesh) + " --reference-dir " + quote(kit) + " --reference-script " +
-                          quote(failing) + " --threads 1 -o " + quote(out_failed),
-                      dir);
+  CliRun rf = bench_against(failing, out_failed);
   INFO("stderr: " << rf.err);
   REQUIRE(rf.exit_code == 0);
   const json jf = parse_json(slurp(out_failed));

@@ -37,11 +37,12 @@ tinygltf::Value level_extras(int level, int image_size, int texture_size, const 
 // asset.extras of a level's own file: only what reading TEXCOORD_0 needs (the level and the
 // texture's side). The file is compared by size against other tools' files, and its JSON was
 // a third of a coarse level's bytes; provenance and quantization are in the combined file
-// (level_extras, asset_extras) and in the convert report.
+// (level_extras, asset_extras) and in the convert report. texture_size 0: the level has no
+// TEXCOORD_0 (GltfLodOptions::texcoords), and the key is left out.
 tinygltf::Value level_file_extras(int level, int texture_size) {
   tinygltf::Value::Object o;
   o["lod"] = detail::json_int(level);
-  o["texture_size"] = detail::json_int(texture_size);
+  if (texture_size > 0) o["texture_size"] = detail::json_int(texture_size);
   tinygltf::Value::Object extras;
   extras["spherekit"] = detail::json_object(std::move(o));
   return detail::json_object(std::move(extras));
@@ -310,6 +311,8 @@ int coarse_texcoord_bits(int level0_bits, int level) {
 Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vector<int>& sizes, int n,
                                    const GltfLodOptions& options, const ProgressFn& progress, const TriMesh* finest) {
   const int levels = static_cast<int>(meshes.size());
+  if (!options.texcoords)
+    for (GltfMesh& m : meshes) m = gltf_mesh_without_texcoords(m);
   // Every level's primitive first: the shared quantization grid must hold all of them (fitted
   // levels can stray a little outside the finest level's bounding box).
   GltfLods out;
@@ -319,10 +322,16 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     const Eigen::Index rows = all_points.V.rows();
     all_points.V.conservativeResize(rows + m.V.rows(), 3);
     all_points.V.bottomRows(m.V.rows()) = m.V;
-    all_points.N.conservativeResize(rows + m.N.rows(), 3);
-    all_points.N.bottomRows(m.N.rows()) = m.N;
-    all_points.UV.conservativeResize(rows + m.UV.rows(), 2);
-    all_points.UV.bottomRows(m.UV.rows()) = m.UV;
+    // An attribute the levels do not have stays empty (resized by V's rows it would hold
+    // uninitialized values).
+    if (m.N.rows() > 0) {
+      all_points.N.conservativeResize(rows + m.N.rows(), 3);
+      all_points.N.bottomRows(m.N.rows()) = m.N;
+    }
+    if (m.UV.rows() > 0) {
+      all_points.UV.conservativeResize(rows + m.UV.rows(), 2);
+      all_points.UV.bottomRows(m.UV.rows()) = m.UV;
+    }
   }
   all_points.position_index.clear();
   SPHEREKIT_ASSIGN_OR_RETURN(out.quantization,
@@ -412,7 +421,7 @@ Result<GltfLods> build_from_meshes(std::vector<GltfMesh> meshes, const std::vect
     doc.model().scenes.emplace_back();
     doc.model().scenes[0].nodes = {0};
     doc.model().defaultScene = 0;
-    doc.model().asset.extras = level_file_extras(k, n);
+    doc.model().asset.extras = level_file_extras(k, level.mesh.UV.rows() > 0 ? n : 0);
     SPHEREKIT_ASSIGN_OR_RETURN(level.glb, doc.to_glb());
     out.levels.push_back(std::move(level));
   }

@@ -164,6 +164,40 @@ GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::ui
   return out;
 }
 
+GltfMesh gltf_mesh_without_texcoords(const GltfMesh& mesh) {
+  if (!check_gltf_mesh(mesh).ok()) return mesh;
+  GltfMesh out;
+  const Eigen::Index points = mesh.V.rows();
+  if (mesh.position_index.empty()) {
+    out = mesh;
+    out.UV.resize(0, 2);
+    out.texture_size = 0;
+    return out;
+  }
+  const std::int32_t largest = *std::max_element(mesh.position_index.begin(), mesh.position_index.end());
+  std::vector<int> merged(static_cast<std::size_t>(largest) + 1, -1), point_of(static_cast<std::size_t>(points));
+  std::vector<Eigen::Index> first;
+  for (Eigen::Index p = 0; p < points; ++p) {
+    int& m = merged[static_cast<std::size_t>(mesh.position_index[static_cast<std::size_t>(p)])];
+    if (m < 0) {
+      m = static_cast<int>(first.size());
+      first.push_back(p);
+    }
+    point_of[static_cast<std::size_t>(p)] = m;
+  }
+  const auto kept = static_cast<Eigen::Index>(first.size());
+  out.V.resize(kept, 3);
+  if (mesh.N.rows() > 0) out.N.resize(kept, 3);
+  for (Eigen::Index q = 0; q < kept; ++q) {
+    out.V.row(q) = mesh.V.row(first[static_cast<std::size_t>(q)]);
+    if (mesh.N.rows() > 0) out.N.row(q) = mesh.N.row(first[static_cast<std::size_t>(q)]);
+  }
+  out.F.resize(mesh.F.rows(), 3);
+  for (Eigen::Index f = 0; f < mesh.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c) out.F(f, c) = point_of[static_cast<std::size_t>(mesh.F(f, c))];
+  return out;
+}
+
 Result<GltfMesh> gltf_mesh_from_trimesh(const TriMesh& mesh) {
   const Eigen::Index nv = mesh.V.rows();
   if (nv == 0 || mesh.F.rows() == 0) return Status(ErrorCode::InvalidInput, "empty mesh");

@@ -259,6 +259,7 @@ Result<ConvertCollectionResult> convert_collection(const ConvertCollectionJob& j
             lo.reference_rms_error = c.assets.measured ? c.assets.error.rms : 0;
             lo.position_bits_rule = o.lod_position_bits;
             lo.normals = o.lod_normals;  // a viewer's flat normals do not change the connectivity
+            lo.texcoords = o.lod_texcoords;  // welds the fold's copies alike on every member
             lo.lod0_max_vertices = c.vertices;  // the largest member's decides (gltf_lods.cpp)
             lo.name = c.name;
             lo.provenance = {c.source, info.dir};

@@ -184,6 +184,7 @@ Result<GeometryAssets> convert_geometry(const TriMesh& mesh, const RowMat3d& S, 
     lo.drop_hole_faces = !collection_member;
     lo.mode = o.lod_mode;  // Original only here (a single mesh)
     lo.normals = o.lod_normals;
+    lo.texcoords = o.lod_texcoords;
     lo.coarse_position_bits = o.lod_coarse_position_bits;
     lo.position_bits_rule = o.lod_position_bits;
     lo.lod0_max_vertices = static_cast<int>(mesh.V.rows());

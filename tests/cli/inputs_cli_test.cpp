@@ -144,6 +144,21 @@ TEST_CASE("inputs: Draco glTF from convert and meshopt glTF are read and mapped"
     CHECK(c.exit_code == 0);
     require_mapped(dir + "/" + glb, dir);
   }
+  // Geometry only (--no-lod-texcoords --no-lod-normals): no TEXCOORD_0 or NORMAL in the file,
+  // fewer bytes, and still a mesh the toolkit reads and maps.
+  const CliRun plain = run_cli("convert " + quote(blob) + " " + quote(dir + "/blob.sphere.obj") + " -o " +
+                                   quote(dir + "/plain.exr") + " --size 33 --lods 2 --psnr-samples 100 --no-lod-texcoords " +
+                                   "--no-lod-normals --quiet",
+                               dir);
+  INFO("stderr: " << plain.err);
+  REQUIRE(plain.exit_code == 0);
+  const std::string with_uv = spherekit::test::slurp(dir + "/gi_lod0.glb"),
+                    without = spherekit::test::slurp(dir + "/plain_lod0.glb");
+  CHECK(with_uv.find("TEXCOORD_0") != std::string::npos);
+  CHECK(without.find("TEXCOORD_0") == std::string::npos);
+  CHECK(without.find("NORMAL") == std::string::npos);
+  CHECK(without.size() < with_uv.size());
+  require_mapped(dir + "/plain_lod0.glb", dir);
   const std::string meshopt = dir + "/blob_meshopt.glb";
   write_text(meshopt, spherekit::test::meshopt_glb(spherekit::test::random_blob(2, 3),
                                                    spherekit::test::MeshoptGlb::QuantizedTriangles));

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <set>
 #include <string>
 
@@ -375,4 +376,42 @@ TEST_CASE("a primitive without some faces keeps the rest in order and drops unus
   // No flags, or flags of the wrong count: unchanged.
   CHECK(gltf_mesh_without_faces(m, {}).F == m.F);
   CHECK(gltf_mesh_without_faces(m, std::vector<std::uint8_t>(3, 1)).V == m.V);
+}
+
+TEST_CASE("a primitive without texture coordinates: the copies of a vertex become one point", "[convert]") {
+  const GeometryImage gi = test::blob_geometry_image(9);
+  auto full = gltf_mesh_from_geometry_image(gi);
+  REQUIRE(full.ok());
+  const GltfMesh& m = full.value();
+  const std::set<std::int32_t> vertices(m.position_index.begin(), m.position_index.end());
+  REQUIRE(vertices.size() < static_cast<std::size_t>(m.V.rows()));  // the folded border pairs
+  const GltfMesh out = gltf_mesh_without_texcoords(m);
+  CHECK(check_gltf_mesh(out).ok());
+  CHECK(out.V.rows() == static_cast<Eigen::Index>(vertices.size()));
+  CHECK(out.UV.rows() == 0);
+  CHECK(out.N.rows() == out.V.rows());
+  CHECK(out.position_index.empty());
+  CHECK(out.texture_size == 0);
+  // Same faces in the same order, each corner at the same position; copies now one point.
+  REQUIRE(out.F.rows() == m.F.rows());
+  std::map<std::int32_t, Eigen::Index> point_of_vertex;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      REQUIRE(out.V.row(out.F(f, k)) == m.V.row(m.F(f, k)));
+      const auto [it, fresh] = point_of_vertex.emplace(m.position_index[static_cast<std::size_t>(m.F(f, k))], out.F(f, k));
+      REQUIRE(it->second == out.F(f, k));
+    }
+  // Encoded, the surface has no seam left: Draco decodes one point per vertex.
+  DracoEncodeOptions e;
+  auto q = choose_draco_quantization(out, 0.0, QuantizationBudget{});
+  REQUIRE(q.ok());
+  e.quantization = q->quantization;
+  auto p = encode_draco_primitive(out, e);
+  REQUIRE(p.ok());
+  CHECK(p->decoded.mesh.V.rows() == out.V.rows());
+  CHECK(p->decoded.mesh.UV.rows() == 0);
+  // A mesh the check refuses: unchanged.
+  GltfMesh bad = m;
+  bad.position_index.pop_back();
+  CHECK(gltf_mesh_without_texcoords(bad).UV.rows() == bad.UV.rows());
 }

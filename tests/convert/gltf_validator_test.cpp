@@ -98,6 +98,15 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     REQUIRE(closed_paths.ok());
     files.insert(files.end(), closed_paths->levels.begin(), closed_paths->levels.end());
     files.push_back(closed_paths->combined);
+    // Without texture coordinates (convert --no-lod-texcoords): the fold's copies are one point.
+    GltfLodOptions plain_original = original;
+    plain_original.texcoords = false;
+    auto untextured = build_original_gltf_lods(blob, blob.V.rowwise().normalized(), 65, plain_original);
+    REQUIRE(untextured.ok());
+    auto untextured_paths = write_gltf_lods(dir + "/original_untextured", untextured.value());
+    REQUIRE(untextured_paths.ok());
+    files.insert(files.end(), untextured_paths->levels.begin(), untextured_paths->levels.end());
+    files.push_back(untextured_paths->combined);
     const test::HoledLodImages holed = test::holed_lod_images(33, 1);
     auto open = build_original_gltf_lods(holed.mesh, holed.S, 33, original);
     REQUIRE(open.ok());
@@ -123,6 +132,13 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
       REQUIRE(morph.ok());
       write("template_morph_plain_lod" + std::to_string(k) + ".glb", morph->glb);
     }
+    auto laid_untextured = build_template_gltf_lods(*layout, members, 65, {plain_original, plain_original});
+    REQUIRE(laid_untextured.ok());
+    for (std::size_t m = 0; m < 2; ++m) write("template_untextured_member" + std::to_string(m) + ".glb", (*laid_untextured)[m].combined_glb);
+    auto untextured_morph = build_gltf_morph_targets(
+        std::vector<GltfMesh>{(*laid_untextured)[0].levels[0].mesh, (*laid_untextured)[1].levels[0].mesh});
+    REQUIRE(untextured_morph.ok());
+    write("template_untextured_morph_plain_lod0.glb", untextured_morph->glb);
   }
 
   // gltf_morph_test: uncompressed, Draco sequential, from triangle meshes.

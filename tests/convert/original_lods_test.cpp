@@ -212,6 +212,36 @@ TEST_CASE("Original LODs: sizes and errors along the levels, texture-coordinate 
   for (std::size_t k = 0; k < 4; ++k) CHECK(again->levels[k].glb == built->levels[k].glb);
 }
 
+TEST_CASE("Original LODs without texture coordinates: the same surfaces, one point per vertex, smaller files",
+          "[convert]") {
+  const OlBlob b = ol_blob();
+  auto with = build_original_gltf_lods(b.mesh, b.S, 257, ol_options(3));
+  GltfLodOptions o = ol_options(3);
+  o.texcoords = false;
+  auto without = build_original_gltf_lods(b.mesh, b.S, 257, o);
+  REQUIRE(with.ok());
+  REQUIRE(without.ok());
+  for (std::size_t k = 0; k < 3; ++k) {
+    const GltfLodLevel& a = with->levels[k];
+    const GltfLodLevel& g = without->levels[k];
+    INFO("level " << k << ": " << a.glb.size() << " -> " << g.glb.size() << " bytes");
+    // The same triangles: the fold's copies of a vertex (two, four at the pole) are one point.
+    CHECK(g.mesh.F.rows() == a.mesh.F.rows());
+    CHECK(g.mesh.UV.rows() == 0);
+    CHECK(g.primitive.decoded.mesh.UV.rows() == 0);
+    const std::set<std::int32_t> vertices(a.mesh.position_index.begin(), a.mesh.position_index.end());
+    CHECK(g.mesh.V.rows() == static_cast<Eigen::Index>(vertices.size()));
+    CHECK(g.mesh.V.rows() < a.mesh.V.rows());
+    CHECK(g.primitive.decoded.mesh.V.rows() == g.mesh.V.rows());
+    for (Eigen::Index f = 0; f < a.mesh.F.rows(); ++f)
+      for (int c = 0; c < 3; ++c) REQUIRE(g.mesh.V.row(g.mesh.F(f, c)) == a.mesh.V.row(a.mesh.F(f, c)));
+    CHECK(g.glb.size() < a.glb.size());
+    // The level file names the texture's side only when it has texture coordinates.
+    CHECK(a.glb.find("texture_size") != std::string::npos);
+    CHECK(g.glb.find("texture_size") == std::string::npos);
+  }
+}
+
 TEST_CASE("Original LODs: the decoded texture coordinates stay within about half a texel", "[convert]") {
   const OlBlob b = ol_blob(8);
   for (int T : {65, 257}) {

@@ -135,6 +135,15 @@ TEST_CASE("template levels: the template laid on every member, one connectivity 
       CHECK((*lods)[0].levels[k].primitive.decoded.mesh.F.rows() == (*lods)[1].levels[k].primitive.decoded.mesh.F.rows());
     }
     CHECK(build_template_gltf_lods(*layout, tl_members(m), 65, {go[0]}).status().code() == ErrorCode::InvalidArgument);
+    // Without texture coordinates the fold's copies become one point alike on every member.
+    for (GltfLodOptions& x : go) x.texcoords = false;
+    auto plain = build_template_gltf_lods(*layout, tl_members(m), 65, go);
+    REQUIRE(plain.ok());
+    for (std::size_t k = 0; k < 3; ++k) {
+      CHECK((*plain)[0].levels[k].mesh.F == (*plain)[1].levels[k].mesh.F);
+      CHECK((*plain)[0].levels[k].mesh.UV.rows() == 0);
+      CHECK((*plain)[0].levels[k].mesh.V.rows() < (*lods)[0].levels[k].mesh.V.rows());
+    }
   }
   SECTION("deterministic") {
     auto again = template_lod_meshes(*lay_template(tl_members(m), 0), o);

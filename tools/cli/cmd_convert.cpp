@@ -105,6 +105,9 @@ void register_convert(CLI::App& app) {
   cmd->add_flag("!--no-lod-normals", args->options.lod_normals,
                 "glTF levels without NORMAL (a viewer derives them from the triangles, as for gltfpack -cc "
                 "output)");
+  cmd->add_flag("!--no-lod-texcoords", args->options.lod_texcoords,
+                "glTF levels without TEXCOORD_0 (geometry only, as gltfpack and gltf-transform files of a mesh "
+                "without texture coordinates; the copies of a vertex at the octahedral fold become one)");
   cmd->add_option("--lod-coarse-position-bits", args->options.lod_coarse_position_bits,
                   "adaptive glTF levels 1..: position bits from each level's own error, at least this many "
                   "(default 0: all levels use level 0's bits)");

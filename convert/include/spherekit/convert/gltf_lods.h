@@ -102,6 +102,11 @@ struct GltfLodOptions {
   /// §3.7.2.1: flat normals), as it does for gltfpack -cc and gltf-transform output of a mesh
   /// without normals; 10-bit octahedral normals are about a third of an adaptive level's bytes.
   bool normals = true;
+  /// Write TEXCOORD_0 (the geometry image's domain: what the shared texture of a collection,
+  /// the transfer and the viewer's grid use). Without it the copies of a vertex at the
+  /// octahedral fold become one point (gltf_mesh_without_texcoords): geometry only, as the
+  /// files of gltfpack and gltf-transform made from a mesh without texture coordinates.
+  bool texcoords = true;
   /// Adaptive levels 1..L-1: position bits from the level's own error (RMS distance to level
   /// 0, sampled) with the budget's error fraction, floored at this many bits (0: off, every
   /// level has the shared bits). A coarse level's error is many times level 0's, so the bits

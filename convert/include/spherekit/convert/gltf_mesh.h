@@ -90,6 +90,14 @@ std::vector<std::uint8_t> gltf_mesh_hole_faces(const GltfMesh& mesh, const Geome
 /// flags of the wrong count, give `mesh` unchanged.
 GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::uint8_t>& drop);
 
+/// `mesh` without texture coordinates: the points that share a position_index (copies of one
+/// surface vertex at a texture seam) become one point, numbered in order of first appearance,
+/// with the first copy's position and normal; faces re-indexed in their order;
+/// position_index empty and texture_size 0. The copies then no longer split the surface, so
+/// an encoder sees one vertex where there were two to four (the octahedral fold of `original`
+/// levels). A mesh check_gltf_mesh refuses gives `mesh` unchanged.
+GltfMesh gltf_mesh_without_texcoords(const GltfMesh& mesh);
+
 /// A triangle mesh as a primitive without texture coordinates: points = vertices, normals =
 /// area-weighted face normals summed per vertex and normalized (a vertex with no non-degenerate
 /// face gets (0, 0, 1)). Errors: InvalidInput (empty mesh, index out of range, NaN/Inf).

@@ -42,6 +42,7 @@ struct ConvertOptions {
   /// levels (one connectivity for all members) under Original as under Adaptive.
   convert::LodMode lod_mode = convert::LodMode::Original;
   bool lod_normals = true;  ///< glTF levels carry NORMAL (GltfLodOptions::normals; single meshes)
+  bool lod_texcoords = true;  ///< glTF levels carry TEXCOORD_0 (GltfLodOptions::texcoords)
   int lod_coarse_position_bits = 0;  ///< GltfLodOptions::coarse_position_bits (adaptive single meshes)
   /// GltfLodOptions::position_bits_rule: each level's bits by rate and distortion (default) or
   /// level 0's bits from the error budget for all.

@@ -1,7 +1,9 @@
 // Stress meshes for the unconstrained stage (issue 20): shapes on which a stretch optimizer
 // is easily out-done, written as OBJ files. Not part of the build; compile by hand:
 //   g++ -O2 -std=c++20 -o /tmp/stress_meshes tools/dev/stress_meshes.cpp
-//   /tmp/stress_meshes OUT_DIR [RES]        (RES: grid cells across the box, default 96)
+//   /tmp/stress_meshes OUT_DIR [RES] [HOLES] [SEED COUNT]
+//     (RES: grid cells across the box, default 96; HOLES: holes of the -holes variants, 0: none;
+//      SEED: COUNT random shapes from that seed instead of the fixed set)
 // Surfaces are the zero set of a smooth union (polynomial smooth minimum) of an ellipsoidal
 // body and capsule chains (long thin limbs), extracted by marching tetrahedra (six per
 // cube): the triangulation is irregular with many near-degenerate triangles, as scans and
@@ -10,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -328,17 +331,47 @@ void write_obj(const Mesh& m, const std::string& path) {
   std::printf("%s V=%zu F=%zu\n", path.c_str(), m.V.size(), m.F.size());
 }
 
+// Shapes nobody tuned for: `count` random creatures from `seed` (xorshift, so the set is the
+// same on every machine): an ellipsoidal body with 3-9 limbs of random direction, length,
+// thickness, taper, segment count and curl, some very thin. A fresh seed is a fresh test set.
+std::vector<Shape> random_shapes(unsigned seed, int count) {
+  std::uint64_t x = 0x9e3779b97f4a7c15ULL ^ (static_cast<std::uint64_t>(seed) * 0xbf58476d1ce4e5b9ULL);
+  auto uniform = [&](double a, double b) {
+    x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+    return a + (b - a) * static_cast<double>(x >> 11) / 9007199254740992.0;
+  };
+  std::vector<Shape> out;
+  for (int i = 0; i < count; ++i) {
+    Shape s{"rand" + std::to_string(seed) + "_" + std::to_string(i),
+            {uniform(0.25, 0.6), uniform(0.2, 0.5), uniform(0.15, 0.5)}, {}, uniform(0.03, 0.1)};
+    const int limbs = static_cast<int>(uniform(3, 10));
+    for (int l = 0; l < limbs; ++l) {
+      const double z = uniform(-1, 1), a = uniform(0, 2 * M_PI), r = std::sqrt(1 - z * z);
+      const V3 d{r * std::cos(a), r * std::sin(a), z};
+      const V3 from{0.8 * s.body_radii.x * d.x, 0.8 * s.body_radii.y * d.y, 0.8 * s.body_radii.z * d.z};
+      const double r0 = uniform(0.025, 0.13);
+      limb(s, from, d, uniform(0.3, 1.4), r0, r0 * uniform(0.3, 1.0), static_cast<int>(uniform(1, 6)),
+           {uniform(-0.8, 0.8), uniform(-0.8, 0.8), uniform(-0.8, 0.8)});
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: stress_meshes OUT_DIR [RES] [HOLES]\n");
+    std::fprintf(stderr, "usage: stress_meshes OUT_DIR [RES] [HOLES] [SEED COUNT]\n");
     return 2;
   }
   std::string dir = argv[1];
   int res = argc > 2 ? std::atoi(argv[2]) : 96;
   int holes = argc > 3 ? std::atoi(argv[3]) : 24;
-  for (const Shape& s : shapes()) {
+  // With SEED: COUNT random shapes (random_shapes) instead of the fixed ones.
+  const std::vector<Shape> set = argc > 4 ? random_shapes(static_cast<unsigned>(std::atoi(argv[4])), argc > 5 ? std::atoi(argv[5]) : 8)
+                                          : shapes();
+  for (const Shape& s : set) {
     Mesh m = largest_component(extract(s, res));
     write_obj(m, dir + "/" + s.name + "_r" + std::to_string(res) + ".obj");
     if (holes > 0) write_obj(punch_holes(m, holes, 12345u), dir + "/" + s.name + "_r" + std::to_string(res) + "-holes.obj");

@@ -448,8 +448,8 @@ int run_bench(const BenchArgs& a) {
   if (linf_compared > 0) {
     std::string over;
     for (const Json& name : linf_over) over += (over.empty() ? "" : ", ") + name.get<std::string>();
-    std::printf("Linf rule (ours <= %.1fx the reference's): %s on %d meshes, worst ratio %.2f%s\n", kLinfRatioLimit,
-                linf_over.empty() ? "pass" : "FAIL", linf_compared, worst_linf_ratio,
+    std::printf("Linf rule (ours <= %.1fx the reference's): %s, %zu of %d meshes above, worst ratio %.2f%s\n",
+                kLinfRatioLimit, linf_over.empty() ? "pass" : "FAIL", linf_over.size(), linf_compared, worst_linf_ratio,
                 linf_over.empty() ? "" : ("; above on " + over).c_str());
   }
 

@@ -250,19 +250,8 @@ Result<DracoPrimitive> encode_draco_primitive(const GltfMesh& mesh, const DracoE
   const auto points = static_cast<std::uint32_t>(mesh.V.rows());
   // Vertices numbered densely in order of first appearance, so that every attribute value
   // belongs to some point (position_index may skip numbers).
-  std::vector<std::int32_t> vertex_of_point;
-  std::int32_t vertices = static_cast<std::int32_t>(points);
-  if (!mesh.position_index.empty()) {
-    const std::int32_t largest = *std::max_element(mesh.position_index.begin(), mesh.position_index.end());
-    std::vector<std::int32_t> dense(static_cast<std::size_t>(largest) + 1, -1);
-    vertices = 0;
-    vertex_of_point.reserve(points);
-    for (const std::int32_t v : mesh.position_index) {
-      std::int32_t& d = dense[static_cast<std::size_t>(v)];
-      if (d < 0) d = vertices++;
-      vertex_of_point.push_back(d);
-    }
-  }
+  std::int32_t vertices = 0;
+  const std::vector<std::int32_t> vertex_of_point = gltf_point_vertices(mesh, &vertices);
 
   draco::Mesh dm;
   dm.set_num_points(points);

@@ -164,28 +164,36 @@ GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::ui
   return out;
 }
 
+std::vector<std::int32_t> gltf_point_vertices(const GltfMesh& mesh, std::int32_t* vertices) {
+  std::vector<std::int32_t> vertex_of_point;
+  *vertices = static_cast<std::int32_t>(mesh.V.rows());
+  if (mesh.position_index.empty()) return vertex_of_point;
+  const std::int32_t largest = *std::max_element(mesh.position_index.begin(), mesh.position_index.end());
+  std::vector<std::int32_t> dense(static_cast<std::size_t>(largest) + 1, -1);
+  *vertices = 0;
+  vertex_of_point.reserve(mesh.position_index.size());
+  for (const std::int32_t v : mesh.position_index) {
+    std::int32_t& d = dense[static_cast<std::size_t>(v)];
+    if (d < 0) d = (*vertices)++;
+    vertex_of_point.push_back(d);
+  }
+  return vertex_of_point;
+}
+
 GltfMesh gltf_mesh_without_texcoords(const GltfMesh& mesh) {
   if (!check_gltf_mesh(mesh).ok()) return mesh;
   GltfMesh out;
-  const Eigen::Index points = mesh.V.rows();
   if (mesh.position_index.empty()) {
     out = mesh;
     out.UV.resize(0, 2);
     out.texture_size = 0;
     return out;
   }
-  const std::int32_t largest = *std::max_element(mesh.position_index.begin(), mesh.position_index.end());
-  std::vector<int> merged(static_cast<std::size_t>(largest) + 1, -1), point_of(static_cast<std::size_t>(points));
-  std::vector<Eigen::Index> first;
-  for (Eigen::Index p = 0; p < points; ++p) {
-    int& m = merged[static_cast<std::size_t>(mesh.position_index[static_cast<std::size_t>(p)])];
-    if (m < 0) {
-      m = static_cast<int>(first.size());
-      first.push_back(p);
-    }
-    point_of[static_cast<std::size_t>(p)] = m;
-  }
-  const auto kept = static_cast<Eigen::Index>(first.size());
+  std::int32_t vertices = 0;
+  const std::vector<std::int32_t> point_of = gltf_point_vertices(mesh, &vertices);
+  std::vector<Eigen::Index> first(static_cast<std::size_t>(vertices), -1);  // each vertex's first point
+  for (Eigen::Index p = mesh.V.rows() - 1; p >= 0; --p) first[static_cast<std::size_t>(point_of[static_cast<std::size_t>(p)])] = p;
+  const auto kept = static_cast<Eigen::Index>(vertices);
   out.V.resize(kept, 3);
   if (mesh.N.rows() > 0) out.N.resize(kept, 3);
   for (Eigen::Index q = 0; q < kept; ++q) {

@@ -34,14 +34,18 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     REQUIRE(formats::write_file_atomic(dir + "/" + name, bytes).ok());
     files.push_back(dir + "/" + name);
   };
+  // A set of levels as convert writes it: each level's file and the MSFT_lod file.
+  auto write_lods = [&](const std::string& prefix, const GltfLods& lods) {
+    auto paths = write_gltf_lods(dir + "/" + prefix, lods);
+    REQUIRE(paths.ok());
+    files.insert(files.end(), paths->levels.begin(), paths->levels.end());
+    files.push_back(paths->combined);
+  };
 
   // gltf_lods_test: the levels, the MSFT_lod file, a single level.
   auto lods = build_gltf_lods(test::lod_test_image(), test::lod_test_options());
   REQUIRE(lods.ok());
-  auto paths = write_gltf_lods(dir + "/blob", lods.value());
-  REQUIRE(paths.ok());
-  files.insert(files.end(), paths->levels.begin(), paths->levels.end());
-  files.push_back(paths->combined);
+  write_lods("blob", lods.value());
   GltfLodOptions one = test::lod_test_options();
   one.levels = 1;
   auto single = build_gltf_lods(test::blob_geometry_image(17), one);
@@ -54,10 +58,7 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     open.drop_hole_faces = true;
     auto holed_lods = build_gltf_lods(holed.levels, open);
     REQUIRE(holed_lods.ok());
-    auto holed_paths = write_gltf_lods(dir + "/holed", holed_lods.value());
-    REQUIRE(holed_paths.ok());
-    files.insert(files.end(), holed_paths->levels.begin(), holed_paths->levels.end());
-    files.push_back(holed_paths->combined);
+    write_lods("holed", holed_lods.value());
   }
 
   // Adaptive levels (adaptive_lods_test): a mesh with holes left open, a collection's levels and
@@ -68,10 +69,7 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     adaptive.drop_hole_faces = true;
     auto holed = build_gltf_lods(test::holed_lod_images(33, 3).levels, adaptive);
     REQUIRE(holed.ok());
-    auto holed_paths = write_gltf_lods(dir + "/adaptive_holed", holed.value());
-    REQUIRE(holed_paths.ok());
-    files.insert(files.end(), holed_paths->levels.begin(), holed_paths->levels.end());
-    files.push_back(holed_paths->combined);
+    write_lods("adaptive_holed", holed.value());
     adaptive.drop_hole_faces = false;
     auto collection = build_consistent_gltf_lods(
         {test::blob_geometry_image(33, 3, 7), test::blob_geometry_image(33, 3, 8)}, {adaptive, adaptive});
@@ -92,21 +90,16 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     original.mode = LodMode::Original;
     original.position_bits_rule = PositionBitsRule::RateDistortion;
     const TriMesh blob = test::random_blob(3, 7);
-    auto closed = build_original_gltf_lods(blob, blob.V.rowwise().normalized(), 65, original);
+    const RowMat3d blob_S = blob.V.rowwise().normalized();
+    auto closed = build_original_gltf_lods(blob, blob_S, 65, original);
     REQUIRE(closed.ok());
-    auto closed_paths = write_gltf_lods(dir + "/original", closed.value());
-    REQUIRE(closed_paths.ok());
-    files.insert(files.end(), closed_paths->levels.begin(), closed_paths->levels.end());
-    files.push_back(closed_paths->combined);
+    write_lods("original", closed.value());
     // Without texture coordinates (convert --no-lod-texcoords): the fold's copies are one point.
     GltfLodOptions plain_original = original;
     plain_original.texcoords = false;
-    auto untextured = build_original_gltf_lods(blob, blob.V.rowwise().normalized(), 65, plain_original);
+    auto untextured = build_original_gltf_lods(blob, blob_S, 65, plain_original);
     REQUIRE(untextured.ok());
-    auto untextured_paths = write_gltf_lods(dir + "/original_untextured", untextured.value());
-    REQUIRE(untextured_paths.ok());
-    files.insert(files.end(), untextured_paths->levels.begin(), untextured_paths->levels.end());
-    files.push_back(untextured_paths->combined);
+    write_lods("original_untextured", untextured.value());
     const test::HoledLodImages holed = test::holed_lod_images(33, 1);
     auto open = build_original_gltf_lods(holed.mesh, holed.S, 33, original);
     REQUIRE(open.ok());
@@ -114,18 +107,13 @@ TEST_CASE("glTF files pass the Khronos validator and decode with draco3d", "[con
     // A collection's levels on its template member's mesh (template_lods_test): two blobs of
     // different connectivity, each level's files and its morph-target file.
     const TriMesh other = test::random_blob(4, 8);
-    const RowMat3d blob_S = blob.V.rowwise().normalized(), other_S = other.V.rowwise().normalized();
+    const RowMat3d other_S = other.V.rowwise().normalized();
     const std::vector<TemplateLodMember> members{{&blob, &blob_S}, {&other, &other_S}};
     auto layout = lay_template(members, 1);
     REQUIRE(layout.ok());
     auto laid = build_template_gltf_lods(*layout, members, 65, {original, original});
     REQUIRE(laid.ok());
-    for (std::size_t m = 0; m < 2; ++m) {
-      auto laid_paths = write_gltf_lods(dir + "/template_member" + std::to_string(m), (*laid)[m]);
-      REQUIRE(laid_paths.ok());
-      files.insert(files.end(), laid_paths->levels.begin(), laid_paths->levels.end());
-      files.push_back(laid_paths->combined);
-    }
+    for (std::size_t m = 0; m < 2; ++m) write_lods("template_member" + std::to_string(m), (*laid)[m]);
     for (std::size_t k = 0; k < (*laid)[0].levels.size(); ++k) {
       auto morph =
           build_gltf_morph_targets(std::vector<GltfMesh>{(*laid)[0].levels[k].mesh, (*laid)[1].levels[k].mesh});

@@ -90,6 +90,12 @@ std::vector<std::uint8_t> gltf_mesh_hole_faces(const GltfMesh& mesh, const Geome
 /// flags of the wrong count, give `mesh` unchanged.
 GltfMesh gltf_mesh_without_faces(const GltfMesh& mesh, const std::vector<std::uint8_t>& drop);
 
+/// The surface vertex of each point, numbered densely in order of first appearance (0, 1, ...
+/// however position_index skips numbers), and their count in *vertices; empty (and *vertices
+/// = #P) when position_index is empty: every point is its own vertex. position_index must hold
+/// #P entries >= 0 (check_gltf_mesh).
+std::vector<std::int32_t> gltf_point_vertices(const GltfMesh& mesh, std::int32_t* vertices);
+
 /// `mesh` without texture coordinates: the points that share a position_index (copies of one
 /// surface vertex at a texture seam) become one point, numbered in order of first appearance,
 /// with the first copy's position and normal; faces re-indexed in their order;

@@ -40,10 +40,10 @@ std::string options_digest(const ConstrainedParamOptions& o) {
   const auto& s = o.sphere;
   std::snprintf(buf, sizeof buf,
                 "reg=%.17g;hole=%.17g;hshape=%.17g;seed=%llu;effort=%d;steiner=%.17g;angle=%.17g;ext=%.17g;side=%d;"
-                "unswirl=%d;flips=%d",
+                "unswirl=%d;flips=%d;arc=%d",
                 s.regularizer_weight, s.hole_weight, s.hole_shape_weight, static_cast<unsigned long long>(s.seed),
                 s.effort, o.steiner_penalty, o.min_angle_deg, o.extremity_fraction, o.sidedness ? 1 : 0,
-                o.unswirl ? 1 : 0, o.edge_flips ? 1 : 0);
+                o.unswirl ? 1 : 0, o.edge_flips ? 1 : 0, o.arc_ranking ? 1 : 0);
   return detail::options_digest_hex(buf);
 }
 
@@ -420,6 +420,7 @@ Result<ConstrainedParamResult> constrained_attempt(const TriMesh& mesh, const st
   no.sidedness = options.sidedness;
   no.unswirl = options.unswirl;
   no.edge_flips = options.edge_flips;
+  no.arc_ranking = options.arc_ranking;
   SPHEREKIT_ASSIGN_OR_RETURN(detail::PathNetwork net, detail::build_path_network(Pn, closed.F, net_fv, net_targets, no, progress));
   result.times.network = seconds_since(t0);
   auto& rep = result.network;

@@ -663,8 +663,22 @@ class Builder {
     return false;
   }
 
+  // The key candidates are ranked by: the path's surface length, or (arc_ranking) the
+  // geometric mean of it and the arc's angle, so that a pair must be close in both
+  // embeddings to go early. By surface length alone, a pair that the surface brings close but
+  // the targets put far apart (a warped member: 0.62 on the surface, 1.78 rad on the sphere,
+  // where its siblings' paths were 0.42-0.51 to another feature) joined the spanning tree
+  // early; its long arc then blocked the arcs the other members' networks have, and their
+  // paths had to wind round (2.17x their shortest route, a map of 0.05 stretch efficiency).
+  // The product is scale-free: neither embedding's size changes the order.
+  double rank_cost(int i, int j, double surface_length) const {
+    if (!opt_.arc_ranking) return surface_length;
+    const double arc = std::acos(std::clamp(T_[static_cast<size_t>(i)].dot(T_[static_cast<size_t>(j)]), -1.0, 1.0));
+    return std::sqrt(surface_length * arc);
+  }
+
   Status greedy() {
-    // Candidates are ranked by (number of penalties, surface length) (§4.1: penalized paths
+    // Candidates are ranked by (number of penalties, rank_cost) (§4.1: penalized paths
     // go to the end of the queue). The extremity and angle penalties depend on the network
     // and are re-evaluated whenever a candidate is popped; the sidedness penalty, once
     // incurred, stays.
@@ -683,7 +697,7 @@ class Builder {
     std::priority_queue<Cand, std::vector<Cand>, std::greater<Cand>> pool;
     for (int i = 0; i < k_; ++i)
       for (int j = i + 1; j < k_; ++j)
-        if (D(i, j) < kInf) pool.push({0, D(i, j), i, j, false});
+        if (D(i, j) < kInf) pool.push({0, rank_cost(i, j, D(i, j)), i, j, false});
     const int needed = 3 * k_ - 6;
     UnionFind uf(k_);
     int components = k_;
@@ -712,8 +726,8 @@ class Builder {
       }
       double len;
       if (!trace(net_, i, j, &nodes, &len)) continue;  // the network only grows: no path for good
-      if (len > c.cost * (1 + 1e-9)) {
-        c.cost = len;  // lazy re-evaluation: costs only grow
+      if (rank_cost(i, j, len) > c.cost * (1 + 1e-9)) {
+        c.cost = rank_cost(i, j, len);  // lazy re-evaluation: costs only grow
         pool.push(c);
         continue;
       }
@@ -884,7 +898,9 @@ class Builder {
         std::vector<Node> nodes;
         double len;
         if (!trace(trial, c, d, &nodes, &len)) continue;
-        if (!(len < p.length * 0.999)) continue;
+        // Shorter by the insertion's ranking (rank_cost), or the flip would undo it: a pair
+        // close on the surface but far apart among the targets came back as the diagonal.
+        if (!(rank_cost(c, d, len) < rank_cost(p.a, p.b, p.length) * 0.999)) continue;
         const size_t mark = splits_.size();
         if (!embed(trial, c, d, nodes, len, D(c, d))) {
           undo_splits_to(net_, mark);

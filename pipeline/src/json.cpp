@@ -79,6 +79,7 @@ Json constrained_options_json(const ConstrainedParamOptions& o) {
   j["unswirl"] = o.unswirl;
   j["edge_flips"] = o.edge_flips;
   j["sidedness"] = o.sidedness;
+  j["arc_ranking"] = o.arc_ranking;
   return j;
 }
 

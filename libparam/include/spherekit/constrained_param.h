@@ -27,6 +27,9 @@ struct ConstrainedParamOptions {
   bool sidedness = true;            ///< defer paths leaving nearby features on the wrong side
   bool unswirl = true;              ///< detect and re-insert swirling paths
   bool edge_flips = true;           ///< replace paths by the shorter diagonal of their quad
+  /// Rank candidate paths by the geometric mean of their surface length and their arc's
+  /// angle between the targets, not by surface length alone (detail/path_network.h).
+  bool arc_ranking = true;
 };
 
 /// The path network as built, for reports and inspection (`--dump-network`).

@@ -32,6 +32,9 @@ struct NetworkOptions {
   /// A path whose length exceeds this multiple of its end points' geodesic distance is
   /// "long" (a swirl symptom, §4.1).
   double long_path_ratio = 1.6;
+  /// Rank candidate paths by the geometric mean of their surface length and their arc's
+  /// angle instead of the surface length alone (path_network.cpp, rank_cost).
+  bool arc_ranking = true;
 };
 
 /// A network edge: feature a to feature b (indices into the feature list), embedded as the

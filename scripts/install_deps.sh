@@ -59,7 +59,18 @@ if [[ "$(id -u)" -ne 0 ]]; then
   SUDO=(sudo)
 fi
 
+# Another package manager at work (a second set-up script, the reference's build script, the
+# system's unattended upgrades) holds dpkg's locks, and apt-get then fails at once ("Could not
+# get lock /var/lib/dpkg/lock-frontend", seen on a new machine with the reference being built
+# beside this script): wait for it, up to 10 minutes, then let apt itself wait for the lock
+# (DPkg::Lock::Timeout) for the race between the check and the call.
+for ((waited = 0; waited < 600; waited += 5)); do
+  pgrep -x 'apt|apt-get|dpkg|unattended-upgr' >/dev/null 2>&1 || break
+  [[ $waited -eq 0 ]] && echo "install_deps: waiting for another apt/dpkg process to finish" >&2
+  sleep 5
+done
 echo "install_deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 "${SUDO[@]}" apt-get update -qq
-"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" </dev/null
+"${SUDO[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+  -o DPkg::Lock::Timeout=600 "${missing[@]}" </dev/null

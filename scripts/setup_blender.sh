@@ -12,7 +12,7 @@ if ! command -v blender >/dev/null 2>&1; then
   if [[ "$(id -u)" -ne 0 ]] && command -v sudo >/dev/null 2>&1; then sudo=(sudo); fi
   echo "setup_blender: installing Debian's blender (apt-get)" >&2
   "${sudo[@]}" apt-get update -qq >&2 || true
-  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends blender \
+  "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends -o DPkg::Lock::Timeout=600 blender \
     </dev/null >&2 || true
 fi
 if ! blender --version >/dev/null 2>&1; then

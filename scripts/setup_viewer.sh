@@ -52,7 +52,7 @@ if [[ "$browser" == 1 && ! -x "$chromium" ]]; then
     echo "setup_viewer: installing Debian's chromium (apt-get)" >&2
     # Failing here is not fatal for the caller: the browser test then skips with the message below.
     "${sudo[@]}" apt-get update -qq >&2 || true
-    "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium \
+    "${sudo[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends -o DPkg::Lock::Timeout=600 chromium \
       </dev/null >&2 || true
   fi
   if [[ ! -x "$chromium" ]]; then

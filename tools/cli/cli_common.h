@@ -207,7 +207,7 @@ struct ConstrainedFlags {
   ConstrainedParamOptions constrained;
   ConstrainedParamOptions resolve(const SphereParamOptions& sphere) const;
 };
-/// Adds --steiner-penalty, --min-angle-deg, --no-unswirl, --no-edge-flips, --no-sidedness
+/// Adds --steiner-penalty, --min-angle-deg, --no-unswirl, --no-edge-flips, --no-sidedness, --no-arc-ranking
 /// (hidden aliases: --min-angle, --no-flips).
 void add_constrained_flags(CLI::App& command, ConstrainedFlags& flags);
 

@@ -663,13 +663,14 @@ class Builder {
     return false;
   }
 
-  // The key candidates are ranked by: the path's surface length, or (arc_ranking) the
+  // The key that ranks candidates: the path's surface length, or (arc_ranking) the
   // geometric mean of it and the arc's angle, so that a pair must be close in both
   // embeddings to go early. By surface length alone, a pair that the surface brings close but
-  // the targets put far apart (a warped member: 0.62 on the surface, 1.78 rad on the sphere,
-  // where its siblings' paths were 0.42-0.51 to another feature) joined the spanning tree
-  // early; its long arc then blocked the arcs the other members' networks have, and their
-  // paths had to wind round (2.17x their shortest route, a map of 0.05 stretch efficiency).
+  // the targets put far apart (a warped member: 0.62 of its bounding-box diagonal on the
+  // surface, 1.78 rad on the sphere, where its siblings' paths were 0.42-0.51 to another
+  // feature) joined the spanning tree early; its long arc then blocked the arcs the other
+  // members' networks have, and the member's paths had to wind round (2.17x their shortest
+  // route, a map of 0.05 stretch efficiency).
   // The product is scale-free: neither embedding's size changes the order.
   double rank_cost(int i, int j, double surface_length) const {
     if (!opt_.arc_ranking) return surface_length;

@@ -123,6 +123,11 @@ class Builder {
     e2 = n.cross(e1);  // e1 x e2 = n: angles grow ccw seen from outside
   }
 
+  // Length (angle) of the minor arc between unit vectors a and b.
+  static double arc_length(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+  }
+
   // Direction angle of the arc from feature i towards feature j, in i's tangent plane.
   double arc_angle(int i, int j) const {
     const Eigen::Vector3d& t = T_[static_cast<size_t>(i)];
@@ -159,7 +164,7 @@ class Builder {
     double ql = q.norm();
     if (!(ql > 0)) return false;
     q /= ql;
-    double len = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+    double len = arc_length(a, b);
     double ta = std::atan2(a.cross(q).dot(n), a.dot(q));
     if (!(ta > margin * len && ta < (1 - margin) * len)) return false;
     *dist = std::asin(std::clamp(std::abs(h), 0.0, 1.0));
@@ -602,7 +607,7 @@ class Builder {
   int sidedness_mismatches(const std::vector<int>& verts, int i, int j) {
     const Eigen::Vector3d& a = T_[static_cast<size_t>(i)];
     const Eigen::Vector3d& b = T_[static_cast<size_t>(j)];
-    double arc = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+    double arc = arc_length(a, b);
     std::vector<std::pair<int, int>> wanted;  // (vertex, sphere side)
     for (int c = 0; c < k_; ++c) {
       if (c == i || c == j) continue;
@@ -674,8 +679,7 @@ class Builder {
   // The product is scale-free: neither embedding's size changes the order.
   double rank_cost(int i, int j, double surface_length) const {
     if (!opt_.arc_ranking) return surface_length;
-    const double arc = std::acos(std::clamp(T_[static_cast<size_t>(i)].dot(T_[static_cast<size_t>(j)]), -1.0, 1.0));
-    return std::sqrt(surface_length * arc);
+    return std::sqrt(surface_length * arc_length(T_[static_cast<size_t>(i)], T_[static_cast<size_t>(j)]));
   }
 
   Status greedy() {

@@ -3,7 +3,9 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/SVD>
+#include <atomic>
 #include <cmath>
+#include <vector>
 
 #include "detail/sphere_embedding.h"
 #include "detail/sphere_state.h"
@@ -519,4 +521,30 @@ TEST_CASE("a pass at its work cap ends there without error, at the same round fo
   // The unconstrained stage's settings set it; the collection stages do not.
   CHECK(optimizer_settings(SphereParamOptions{}).pass_work_cap == 64);
   CHECK(optimizer_settings(collection_sphere_options()).pass_work_cap == 0);
+}
+
+TEST_CASE("the worker pool runs every item of a loop once, for any size, chunk and thread count",
+          "[param][threads]") {
+  // Each thread first drains its own segment of the range, then the others' (worker_pool.h):
+  // items at segment ends, loops smaller than the thread count and chunks larger than a
+  // segment must still be visited exactly once, and each thread index within range.
+  for (int threads : {1, 2, 3, 5}) {
+    WorkerPool pool(threads);
+    for (int n : {1, 2, 7, 8, 64, 1001}) {
+      for (int chunk : {1, 4, 300}) {
+        std::vector<std::atomic<int>> visits(static_cast<size_t>(n));
+        std::atomic<int> bad_thread{0};
+        for (int loop = 0; loop < 3; ++loop)
+          pool.parallel_for(n, chunk, 1, [&](int i, int thread) {
+            visits[static_cast<size_t>(i)].fetch_add(1);
+            if (thread < 0 || thread >= pool.threads()) bad_thread.fetch_add(1);
+          });
+        int wrong = 0;
+        for (auto& v : visits) wrong += v.load() != 3;
+        INFO("threads " << threads << " n " << n << " chunk " << chunk);
+        CHECK(wrong == 0);
+        CHECK(bad_thread.load() == 0);
+      }
+    }
+  }
 }

@@ -285,4 +285,26 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
   return Status();
 }
 
+int leave_out_folded_samples(const RowMat3i& F, const RowMat3d& Sc, const std::vector<int>& spread,
+                             std::vector<char>* inside) {
+  std::vector<char> folded(static_cast<size_t>(Sc.rows()), 0), near(static_cast<size_t>(Sc.rows()), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    if (orient3d_origin(Sc.row(F(f, 0)).data(), Sc.row(F(f, 1)).data(), Sc.row(F(f, 2)).data()) <= 0)
+      for (int c = 0; c < 3; ++c) folded[static_cast<size_t>(F(f, c))] = 1;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const bool touches = folded[static_cast<size_t>(F(f, 0))] || folded[static_cast<size_t>(F(f, 1))] ||
+                         folded[static_cast<size_t>(F(f, 2))];
+    if (touches)
+      for (int c = 0; c < 3; ++c) near[static_cast<size_t>(F(f, c))] = 1;
+  }
+  int marked = 0;
+  for (int w : spread)
+    if ((*inside)[static_cast<size_t>(w)] && near[static_cast<size_t>(w)]) {
+      (*inside)[static_cast<size_t>(w)] = 0;
+      ++marked;
+    }
+  return marked;
+}
+
+
 }  // namespace spherekit::detail

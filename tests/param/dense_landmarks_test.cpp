@@ -115,6 +115,48 @@ TEST_CASE("feature warp carries features onto their targets bijectively, or refu
   }
 }
 
+TEST_CASE("fitted targets that fold the map: their samples are left out and the flow goes through",
+          "[param][constrained][dense]") {
+  // The correspondence refinement flows a member's map onto fitted partners at samples
+  // (refine_correspondence.cpp); where the fit folds the map, no flow can follow and the
+  // samples there are left out (detail::leave_out_folded_samples) after the flow failed.
+  const TriMesh m = test::icosphere(3);
+  const RowMat3d S = m.V;
+  std::vector<int> spread;
+  for (int v = 0; v < m.V.rows(); v += 9) spread.push_back(v);
+  std::vector<char> inside(static_cast<size_t>(m.V.rows()), 1);
+  // No fold: nothing is left out.
+  CHECK(detail::leave_out_folded_samples(m.F, S, spread, &inside) == 0);
+  CHECK(std::count(inside.begin(), inside.end(), 0) == 0);
+  // The two closest samples trade places in the fitted map: faces around them invert.
+  size_t a = 0, b = 1;
+  for (size_t i = 0; i < spread.size(); ++i)
+    for (size_t j = i + 1; j < spread.size(); ++j)
+      if ((S.row(spread[i]) - S.row(spread[j])).norm() < (S.row(spread[a]) - S.row(spread[b])).norm()) a = i, b = j;
+  RowMat3d Sc = S;
+  Sc.row(spread[a]) = S.row(spread[b]);
+  Sc.row(spread[b]) = S.row(spread[a]);
+  REQUIRE(count_flipped_faces(m.F, Sc) > 0);
+  auto flow = [&](RowMat3d* out) {
+    std::vector<int> fv;
+    std::vector<Eigen::Vector3d> t;
+    for (int w : spread)
+      if (inside[static_cast<size_t>(w)]) fv.push_back(w), t.push_back(Sc.row(w).transpose());
+    *out = S;
+    return detail::warp_features_to_targets(m.V, m.F, fv, t, {}, out);
+  };
+  RowMat3d out;
+  CHECK(flow(&out).code() == ErrorCode::SolverFailed);
+  const int left_out = detail::leave_out_folded_samples(m.F, Sc, spread, &inside);
+  CHECK(left_out >= 2);
+  CHECK(left_out <= 6);  // the pair and at most a few samples next to their faces
+  CHECK(inside[static_cast<size_t>(spread[a])] == 0);
+  CHECK(inside[static_cast<size_t>(spread[b])] == 0);
+  REQUIRE(flow(&out).ok());
+  CHECK(count_flipped_faces(m.F, out) == 0);
+  test::require_valid_map(m, out);
+}
+
 TEST_CASE("feature warp: where a feature passes close by another, the relaxation lets the flow go on",
           "[param][constrained][dense]") {
   // A bumpy blob's unconstrained map with 28 features standing still, and feature A whose arc

@@ -82,4 +82,12 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
                                 const std::vector<Eigen::Vector3d>& targets, const ProgressFn& progress, RowMat3d* S,
                                 WarpStats* stats = nullptr, const WarpRelaxFn& relax = {});
 
+/// Flow targets taken from a fitted correspondence (the correspondence refinement): marks the
+/// samples `spread` that lie on or next to a face of F that the composed map Sc inverts (the
+/// vertices of those faces and of every face touching them; exact predicate) as having no
+/// target (inside[w] = 0) and returns how many it marked. Where a fit folds a member's map,
+/// its targets ask for a fold that no bijective flow makes, whichever samples carry them.
+int leave_out_folded_samples(const RowMat3i& F, const RowMat3d& Sc, const std::vector<int>& spread,
+                             std::vector<char>* inside);
+
 }  // namespace spherekit::detail

@@ -306,5 +306,4 @@ int leave_out_folded_samples(const RowMat3i& F, const RowMat3d& Sc, const std::v
   return marked;
 }
 
-
 }  // namespace spherekit::detail

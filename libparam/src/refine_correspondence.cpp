@@ -615,7 +615,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
               // tried again. Only after a failure: on the shared families every flow succeeds,
               // and leaving these samples out always cost there (faust5k 0.022/0.034/0.020 ->
               // 0.025/0.036/0.022), while on a random creature family two of three members
-              // kept their step-6 maps without it (0.057/0.063/0.058 -> 0.045/0.051/0.055).
+              // kept their step-6 maps without it (0.057/0.063/0.058 -> 0.044/0.051/0.058).
               left_out = detail::leave_out_folded_samples(mi.F, Sc, spread, &inside);
               if (left_out == 0) break;
               samples = round_samples;

@@ -139,7 +139,7 @@ class WorkerPool {
   const std::function<void(int, int)>* body_ = nullptr;
   int n_ = 0, chunk_ = 1;
   std::atomic<int> joined_{0};  // workers running the current loop (changed under mutex_)
-  // One cursor per thread's segment, each on its own cache line (kSegments >= threads()).
+  // One cursor per thread's segment (threads() of them), each on its own cache line.
   struct alignas(64) Cursor {
     std::atomic<int> next{0};
     int end = 0;

@@ -606,6 +606,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           RowMat3d S;
           const int round_samples = samples;
           int left_out = 0;
+          auto finished = [&] { return st.ok() || st.code() == ErrorCode::Cancelled || !keep_going(); };
           for (int attempt = 0; attempt < 2; ++attempt) {
             if (attempt == 1) {
               // The flow failed at every sample count. Where the fit folds the member's map
@@ -630,9 +631,9 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
                 if (inside[static_cast<size_t>(w)]) fv.push_back(w), targets.push_back(Sc.row(w).transpose());
               S = cur;
               st = detail::warp_features_to_targets(mi.V, mi.F, fv, targets, {}, &S);
-              if (st.ok() || st.code() == ErrorCode::Cancelled || !keep_going()) break;
+              if (finished()) break;
             }
-            if (st.ok() || st.code() == ErrorCode::Cancelled || !keep_going()) break;
+            if (finished()) break;
           }
           if (!keep_going()) return Status(ErrorCode::Cancelled, "cancelled");
           if (!st.ok()) {

@@ -5,8 +5,9 @@
 // between regions, which on a loaded machine burns a core per thread for nothing (the CPU
 // time with two threads was 1.1-2x that of one) and delays the threads that have work. Here
 // idle workers block on a condition variable, the calling thread takes part in every loop,
-// and items are handed out in chunks by an atomic counter. Results must not depend on which
-// thread runs an item (the callers write only to the item's own slot).
+// and items are handed out in chunks from per-thread segments of the range (run_chunks).
+// Results must not depend on which thread runs an item (the callers write only to the item's
+// own slot).
 #pragma once
 
 #include <algorithm>
@@ -52,7 +53,6 @@ class WorkerPool {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       body_ = &body;
-      n_ = n;
       chunk_ = std::max(1, chunk);
       const int segments = static_cast<int>(cursors_.size());
       for (int k = 0; k < segments; ++k) {
@@ -137,7 +137,7 @@ class WorkerPool {
   std::mutex mutex_;
   std::condition_variable start_cv_, done_cv_;
   const std::function<void(int, int)>* body_ = nullptr;
-  int n_ = 0, chunk_ = 1;
+  int chunk_ = 1;
   std::atomic<int> joined_{0};  // workers running the current loop (changed under mutex_)
   // One cursor per thread's segment (threads() of them), each on its own cache line.
   struct alignas(64) Cursor {

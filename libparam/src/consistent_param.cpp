@@ -67,11 +67,15 @@ ConstrainedParamResult as_constrained(const SphereParamResult& r) {
   return c;
 }
 
-// Constrained maps of the meshes `which` to `targets`, several at once (steps 2 and 6).
+// Constrained maps of the meshes `which` to `targets`, several at once (steps 2 and 6), each
+// made again where it keeps too little of its mesh's unconstrained efficiency
+// (constrained_param_or_retry); a mesh's unconstrained efficiency is computed where it is
+// still 0 in `unconstrained_efficiency` (step 2) and reused after (step 6).
 Status constrained_maps(const std::vector<TriMesh>& meshes, const std::vector<std::vector<int>>& features,
                         const std::vector<int>& which, const std::vector<Eigen::Vector3d>& targets,
                         const ConsistentParamOptions& options, const std::string& stage, const ProgressFn& progress,
-                        std::vector<ConstrainedParamResult>* out, MeshFailure* failure) {
+                        std::vector<ConstrainedParamResult>* out, std::vector<double>* unconstrained_efficiency,
+                        MeshFailure* failure) {
   // Each job's own error, so that the failing mesh is known as a value: run_parallel_jobs
   // returns the lowest-numbered job's real failure.
   std::vector<Status> reasons(which.size());
@@ -81,8 +85,21 @@ Status constrained_maps(const std::vector<TriMesh>& meshes, const std::vector<st
         const int i = which[static_cast<size_t>(j)];
         ConstrainedParamOptions o = options.constrained;
         o.sphere.threads = threads;  // effort only: same bits for any count
-        auto r = parameterize_sphere_constrained(meshes[static_cast<size_t>(i)], features[static_cast<size_t>(i)],
-                                                 targets, o, [&](const ProgressEvent&) { return keep_going(); });
+        const ProgressFn cancel = [&](const ProgressEvent&) { return keep_going(); };
+        double& unconstrained = (*unconstrained_efficiency)[static_cast<size_t>(i)];
+        if (options.efficiency_retry > 0 && unconstrained == 0) {
+          // The mesh's own unconstrained map, once (step 2), with step 1's settings.
+          SphereParamOptions so = o.sphere;
+          so.align_rotation = false;
+          auto u = parameterize_sphere(meshes[static_cast<size_t>(i)], so, cancel);
+          if (!u.ok()) {
+            reasons[static_cast<size_t>(j)] = u.status();
+            return u.status().with_context(mesh_label(i));
+          }
+          unconstrained = u->efficiency;
+        }
+        auto r = constrained_param_or_retry(meshes[static_cast<size_t>(i)], features[static_cast<size_t>(i)], targets,
+                                            o, unconstrained, options.efficiency_retry, cancel);
         if (!r.ok()) reasons[static_cast<size_t>(j)] = r.status();
         else if (r->flipped_faces != 0)  // never expected: the stage checks; a guard for the collection
           reasons[static_cast<size_t>(j)] = Status(ErrorCode::Internal, "constrained map has flipped faces");
@@ -324,6 +341,8 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
     if (!r.ok()) return fail_mesh(ref, r.status());
     for (int v : features[static_cast<size_t>(ref)]) result.initial_locations.push_back(r->map.S.row(v).transpose());
     result.reference_efficiency = r->efficiency;
+    result.unconstrained_efficiency.assign(static_cast<size_t>(n), 0.0);
+    if (options.efficiency_retry > 0) result.unconstrained_efficiency[static_cast<size_t>(ref)] = r->efficiency;
     result.maps[static_cast<size_t>(ref)] = as_constrained(r.value());
   }
   result.times.reference = seconds_since(t0);
@@ -335,7 +354,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   for (int i = 0; i < n; ++i)
     if (i != ref) others.push_back(i);
   SPHEREKIT_RETURN_IF_ERROR(constrained_maps(meshes, features, others, result.initial_locations, options, "step 2",
-                                             progress, &result.maps, &failure));
+                                             progress, &result.maps, &result.unconstrained_efficiency, &failure));
   result.times.initial = seconds_since(t0);
   result.final_locations = result.initial_locations;
   if (!options.refine_locations || n < 2) {
@@ -423,7 +442,7 @@ Result<ConsistentParamResult> parameterize_consistent(const std::vector<TriMesh>
   std::vector<ConstrainedParamResult> final_maps(static_cast<size_t>(n));
   MeshFailure failure6;
   const Status s6 = constrained_maps(meshes, features, all, result.final_locations, options, "step 6", progress,
-                                     &final_maps, &failure6);
+                                     &final_maps, &result.unconstrained_efficiency, &failure6);
   // A step-6 map can also complete and still be poor: where F moves features so that a
   // member's network must wind round (ICT heads with the nose tip and chin added to proposed
   // landmarks: one head's longest path 2.4x its shortest route, efficiency 0.43 against 0.80

@@ -18,6 +18,7 @@
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/metrics.h"
 #include "spherekit/propose_landmarks.h"
+#include "spherekit/sphere_param.h"
 #include "spherekit/pipeline/collection.h"
 #include "spherekit/pipeline/collection_update.h"
 #include "spherekit/pipeline/json.h"
@@ -281,6 +282,8 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
     e.feature_vertices = std::vector<long long>(m.feature_vertices.begin(), m.feature_vertices.end());
     e.added = false;
     e.result = map_entry_json(r.maps[i]);
+    if (i < r.unconstrained_efficiency.size() && r.unconstrained_efficiency[i] > 0)
+      e.result["unconstrained_efficiency"] = r.unconstrained_efficiency[i];
     if (i < r.refinement.members.size()) e.result["correspondence_refinement"] = refinement_json(r.refinement.members[i]);
     man.members.push_back(std::move(e));
   }
@@ -288,6 +291,7 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
   man.options["remesh_size"] = o.remesh_size;
   man.options["refine_locations"] = o.refine_locations;
   man.options["refine_correspondence"] = o.refine_correspondence;
+  man.options["efficiency_retry"] = o.efficiency_retry;
   if (o.refine_correspondence)
     man.options["refinement"] = Json{{"iterations", o.refinement.iterations},
                                      {"damping", o.refinement.damping},
@@ -318,6 +322,8 @@ Json map_entry_json(const ConstrainedParamResult& r) {
   Json j = constrained_measures_json(r);
   j["method"] = r.map.provenance.method;
   j["network"] = feature_network_json(r.network);
+  if (r.efficiency_retried)  // constrained_param_or_retry: made twice, the more efficient kept
+    j["efficiency_retry"] = Json{{"first_efficiency", r.first_efficiency}, {"as_unconstrained", r.as_unconstrained}};
   return j;
 }
 
@@ -463,16 +469,31 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
     const Json& opt = c.manifest.options;
     if (opt.is_object() && opt.contains("seed") && opt["seed"].is_number_unsigned() && !a.seed_given)
       o.sphere.seed = opt["seed"].get<std::uint64_t>();
-    auto result = parameterize_sphere_constrained(mesh, fv, F, o, progress);
+    double retry = a.efficiency_retry;
+    if (opt.is_object() && opt.contains("efficiency_retry") && opt["efficiency_retry"].is_number() &&
+        !a.efficiency_retry_given)
+      retry = opt["efficiency_retry"].get<double>();
+    double unconstrained = 0;
+    if (retry > 0 && !o.as_unconstrained) {
+      // The new mesh's own unconstrained map, what the retry compares against (as in steps 2 and 6).
+      SphereParamOptions so = o.sphere;
+      so.align_rotation = false;
+      auto u = parameterize_sphere(mesh, so, progress);
+      if (!u.ok()) return with_file(u.status(), a.mesh);
+      unconstrained = u->efficiency;
+    }
+    auto result = constrained_param_or_retry(mesh, fv, F, o, unconstrained, retry, progress);
     if (!result.ok()) return with_file(with_landmark_hint(result.status(), suspect_names, lm), a.mesh);
     out.map = std::move(result).value();
     SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
     e.result = map_entry_json(out.map);
+    if (unconstrained > 0) e.result["unconstrained_efficiency"] = unconstrained;
     if (a.refine_correspondence) {
       SPHEREKIT_ASSIGN_OR_RETURN(std::optional<RefinedMember> refined,
                                  refine_added_member(c, existing, mesh, fv, F, progress, &out.map));
       if (refined) {
         e.result = map_entry_json(out.map);
+        if (unconstrained > 0) e.result["unconstrained_efficiency"] = unconstrained;
         e.result["correspondence_refinement"] = refinement_json(*refined);
       }
     }

@@ -80,6 +80,7 @@ Json constrained_options_json(const ConstrainedParamOptions& o) {
   j["edge_flips"] = o.edge_flips;
   j["sidedness"] = o.sidedness;
   j["arc_ranking"] = o.arc_ranking;
+  j["as_unconstrained"] = o.as_unconstrained;
   return j;
 }
 

@@ -132,7 +132,11 @@ void bind_param(pyb::module_& m) {
   auto constrained_result = pyb::class_<ConstrainedParamResult>(m, "ConstrainedParamResult");
   bind_map_measures(constrained_result);
   constrained_result.def_readonly("max_feature_angle", &ConstrainedParamResult::max_feature_angle)
-      .def_readonly("network", &ConstrainedParamResult::network);
+      .def_readonly("network", &ConstrainedParamResult::network)
+      .def_readonly("efficiency_retried", &ConstrainedParamResult::efficiency_retried,
+                    "made twice: the first kept too little of the unconstrained efficiency (collections)")
+      .def_readonly("first_efficiency", &ConstrainedParamResult::first_efficiency)
+      .def_readonly("as_unconstrained", &ConstrainedParamResult::as_unconstrained);
 
   m.def(
       "param_constrained",
@@ -157,6 +161,8 @@ void bind_param(pyb::module_& m) {
       .def_property_readonly("final_locations", [](const ConsistentParamResult& r) { return from_points(r.final_locations); },
                              "F (step 5), k x 3; features.txt of the collection folder")
       .def_readonly("reference_efficiency", &ConsistentParamResult::reference_efficiency)
+      .def_readonly("unconstrained_efficiency", &ConsistentParamResult::unconstrained_efficiency,
+                    "per mesh: its unconstrained map's efficiency (0 with efficiency_retry=0)")
       .def_readonly("joint_efficiency", &ConsistentParamResult::joint_efficiency)
       .def_readonly("joint_flips", &ConsistentParamResult::joint_flips)
       .def_readonly("remesh_vertices", &ConsistentParamResult::remesh_vertices)
@@ -184,14 +190,15 @@ void bind_param(pyb::module_& m) {
   m.def(
       "consistent",
       [](const std::vector<Mesh>& meshes, const std::vector<std::vector<int>>& features, int reference, int remesh_size,
-         bool refine_locations, bool refine_correspondence, int effort, std::uint64_t seed, int threads,
-         Callback progress) {
+         bool refine_locations, bool refine_correspondence, double efficiency_retry, int effort, std::uint64_t seed,
+         int threads, Callback progress) {
         ConsistentParamOptions o;
         o.constrained.sphere = collection_options(effort, seed, threads);
         o.reference = reference;
         o.remesh_size = remesh_size;
         o.refine_locations = refine_locations;
         o.refine_correspondence = refine_correspondence;
+        o.efficiency_retry = efficiency_retry;
         o.threads = threads;
         std::vector<TriMesh> tri;
         for (const Mesh& mesh : meshes) tri.push_back(mesh.mesh);
@@ -212,7 +219,8 @@ void bind_param(pyb::module_& m) {
         return std::move(result).value();
       },
       pyb::arg("meshes"), pyb::arg("features"), pyb::kw_only(), pyb::arg("reference") = 0, pyb::arg("remesh_size") = 65,
-      pyb::arg("refine_locations") = true, pyb::arg("refine_correspondence") = true, pyb::arg("effort") = 2,
+      pyb::arg("refine_locations") = true, pyb::arg("refine_correspondence") = true,
+      pyb::arg("efficiency_retry") = ConsistentParamOptions{}.efficiency_retry, pyb::arg("effort") = 2,
       pyb::arg("seed") = 1, pyb::arg("threads") = 0, pyb::arg("progress") = pyb::none(),
       "Consistent maps of a collection (the paper's six steps, then the correspondence refinement; as\n"
       "`spherekit consistent`): features[i] lists\n"

@@ -2,6 +2,7 @@
 # same error messages as exceptions, cancellation through the progress callback and Ctrl-C,
 # numpy views instead of copies.
 import filecmp
+import json
 import os
 import signal
 import subprocess
@@ -64,6 +65,13 @@ def test_consistent_writes_the_cli_bytes(exe, samples, tmp_path):
     cli_names, cli_locations = sk.read_sphere_points(str(col / "features.txt"))
     assert cli_names == order
     assert np.array_equal(cli_locations, result.final_locations)
+    # Every member's unconstrained efficiency (what the efficiency retry compares against), as
+    # collection.json records it; a retried map says so only below the bar.
+    manifest = json.loads((col / "collection.json").read_text())
+    assert len(result.unconstrained_efficiency) == len(names)
+    for entry, u, m in zip(manifest["meshes"], result.unconstrained_efficiency, result.maps):
+        assert 0 < u <= 1 and entry["result"]["unconstrained_efficiency"] == u
+        assert not m.efficiency_retried or m.first_efficiency < 0.8 * u
 
 
 def test_errors_are_exceptions_with_the_cli_messages(exe, tmp_path):

@@ -358,7 +358,7 @@ TEST_CASE("param writes a bijective unit sphere map and eval agrees", "[cli]") {
   require_one_line_error(mismatch, sphere);
 }
 
-TEST_CASE("param: a constrained map takes the collection stages' anti-cruft and hole shape weights unless the flags are given, and ranks its network on both embeddings unless --no-arc-ranking",
+TEST_CASE("param: a constrained map takes the collection stages' anti-cruft and hole shape weights unless the flags are given, and ranks its network on both embeddings unless --no-arc-ranking (--as-unconstrained off unless given)",
           "[cli]") {
   // The unconstrained map's default weight is lower (sphere_param.h); a constrained map is the
   // map `consistent` or `add` would make, so `param --features` keeps theirs.
@@ -407,6 +407,9 @@ TEST_CASE("param: a constrained map takes the collection stages' anti-cruft and 
   // The path network's ranking (path_network.cpp, rank_cost): on unless switched off.
   CHECK(option(constrained, "arc_ranking").get<bool>());
   CHECK_FALSE(option(constrained + " --no-arc-ranking", "arc_ranking").get<bool>());
+  // The unconstrained stage's simplification and energy: off unless asked for.
+  CHECK_FALSE(option(constrained, "as_unconstrained").get<bool>());
+  CHECK(option(constrained + " --as-unconstrained", "as_unconstrained").get<bool>());
 }
 
 TEST_CASE("param checks every output folder before writing anything", "[cli]") {

@@ -93,6 +93,18 @@ TEST_CASE("consistent writes a collection; add grows it; correspond uses it", "[
   CHECK(read_json(dir + "/report.json")["times"]["step5_joint_map"].get<double>() > 0);
   require_features_on_locations(s, col, "sample_a");
   require_features_on_locations(s, col, "sample_b");
+  // Every member's unconstrained efficiency, what the efficiency retry compares against; a
+  // member made twice says so only where its first map kept less than the bar.
+  CHECK(man["options"]["efficiency_retry"].get<double>() == 0.8);
+  for (const json& m : man["meshes"]) {
+    INFO(m["name"]);
+    REQUIRE(m["result"].contains("unconstrained_efficiency"));
+    const double u = m["result"]["unconstrained_efficiency"].get<double>();
+    CHECK(u > 0);
+    CHECK(u <= 1);
+    if (m["result"].contains("efficiency_retry"))
+      CHECK(m["result"]["efficiency_retry"]["first_efficiency"].get<double>() < 0.8 * u);
+  }
   // No staging folders left beside it.
   for (const auto& e : fs::directory_iterator(dir)) CHECK(e.path().filename().string().rfind(".col", 0) != 0);
 
@@ -104,6 +116,7 @@ TEST_CASE("consistent writes a collection; add grows it; correspond uses it", "[
   man = read_json(col + "/collection.json");
   REQUIRE(man["meshes"].size() == 3);
   CHECK(man["meshes"][2]["added"] == true);
+  CHECK(man["meshes"][2]["result"]["unconstrained_efficiency"].get<double>() > 0);
   // The collection was made with the correspondence refinement (the default): consistent
   // recorded it per member, and add refined the new map against the reference the same way.
   CHECK(man["options"]["refine_correspondence"] == true);

@@ -292,6 +292,8 @@ void add_constrained_flags(CLI::App& cmd, ConstrainedFlags& f) {
   cmd.add_flag("!--no-edge-flips", o.edge_flips, "skip path edge flips");
   cmd.add_flag("!--no-sidedness", o.sidedness, "skip the sidedness tests");
   cmd.add_flag("!--no-arc-ranking", o.arc_ranking, "rank candidate paths by surface length alone, not with their arcs");
+  cmd.add_flag("--as-unconstrained", o.as_unconstrained,
+               "simplify and optimize as the unconstrained stage does (keeps thin limbs' share of the sphere)");
   cmd.add_option("--min-angle", o.min_angle_deg)->check(CLI::Range(0.0, 60.0))->group("");
   cmd.add_flag("!--no-flips", o.edge_flips)->group("");
 }

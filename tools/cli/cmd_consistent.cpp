@@ -119,6 +119,11 @@ void register_consistent(CLI::App& app) {
   cmd->add_flag("!--no-refine", args->job.options.refine_locations)->group("");  // the earlier spelling
   cmd->add_flag("!--no-refine-correspondence", args->job.options.refine_correspondence,
                 "keep the step-6 maps (no correspondence refinement against the reference)");
+  cmd->add_option("--efficiency-retry", args->job.options.efficiency_retry,
+                  "make a member's constrained map again as the unconstrained stage would where it keeps less than this "
+                  "fraction of its unconstrained efficiency (0: never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--report", args->report, "also write a JSON report here");
   cmd->add_flag("-q,--quiet", args->quiet, "print neither progress nor the summary (errors still)");
   add_sphere_param_options(*cmd, args->sphere);
@@ -140,6 +145,10 @@ void register_consistent(CLI::App& app) {
                   "register this sphere map (computed elsewhere, e.g. by 'param --features F.lm.txt --targets "
                   "DIR/features.txt') instead of computing one; verified: same vertices and faces, bijective by the "
                   "exact predicate, every feature on its location");
+  add->add_option("--efficiency-retry", add_args->job.efficiency_retry,
+                  "as for consistent (default: the collection's setting)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->each([add_args](const std::string&) { add_args->job.efficiency_retry_given = true; });
   add->add_option("--report", add_args->report, "also write a JSON report (times, peak memory) here");
   add->add_flag("-q,--quiet", add_args->quiet, "print neither progress nor the summary (errors still)");
   add_sphere_param_options(*add, add_args->sphere);

@@ -45,6 +45,13 @@ struct ConsistentParamOptions {
   /// only at them. Its template is `reference`; its threads are `threads`. Shape-defining.
   bool refine_correspondence = true;
   RefineCorrespondenceOptions refinement;
+  /// A constrained map of steps 2 and 6 keeping less than this fraction of its mesh's
+  /// unconstrained stretch efficiency is made again as the unconstrained stage simplifies and
+  /// optimizes (constrained_param_or_retry), the more efficient kept; every member's
+  /// unconstrained map is then made once (step 1's for the reference). 0: no retry, no
+  /// unconstrained maps. 0.8 is the floor the collection's maps are held to (issue 19).
+  /// Shape-defining.
+  double efficiency_retry = 0.8;
   /// Worker threads in total (0 = hardware). Steps 2 and 6 map several meshes at once.
   /// Effort only: the result is the same for any value.
   int threads = 0;
@@ -69,6 +76,9 @@ struct ConsistentParamResult {
   std::vector<Eigen::Vector3d> initial_locations;  ///< F' (step 1), one per feature
   std::vector<Eigen::Vector3d> final_locations;    ///< F (step 5); equal to F' without refinement
   double reference_efficiency = 0;  ///< step 1 map's stretch efficiency
+  /// Per mesh: its unconstrained map's stretch efficiency (the reference's is step 1's; all 0
+  /// when efficiency_retry is 0), what the retry and the refinement's floor compare against.
+  std::vector<double> unconstrained_efficiency;
   double joint_efficiency = 0;      ///< step 5: efficiency of the summed stretch (0 if not run)
   int joint_flips = 0;              ///< step 5 map's flipped faces (exact predicate; 0)
   int remesh_vertices = 0;          ///< vertices of the joint mesh (0 if not run)

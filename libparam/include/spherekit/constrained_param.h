@@ -30,6 +30,13 @@ struct ConstrainedParamOptions {
   /// Rank candidate paths by the geometric mean of their surface length and their arc's
   /// angle between the targets, not by surface length alone (detail/path_network.h).
   bool arc_ranking = true;
+  /// Simplify and optimize as the unconstrained stage does (sphere_param.cpp: quadrics with
+  /// the vertex normals, memoryless; edge-frame anti-cruft; the final pass on the measured
+  /// energy) instead of with the collection stages' settings. Thin limbs then keep their
+  /// share of the sphere at the coarse levels. Off by default: with the collection's
+  /// settings the correspondence comes out better where both are efficient (measured in
+  /// constrained_param_or_retry's comment); the collections use it as their retry.
+  bool as_unconstrained = false;
 };
 
 /// The path network as built, for reports and inspection (`--dump-network`).
@@ -68,6 +75,12 @@ struct ConstrainedParamResult {
   int holes_filled = 0;
   FeatureNetworkReport network;
   ConstrainedParamTimes times;
+  /// constrained_param_or_retry(): the map was made twice (the first kept too little of the
+  /// unconstrained efficiency), with the efficiency of the first attempt; whether the map
+  /// returned is the second (made with as_unconstrained).
+  bool efficiency_retried = false;
+  double first_efficiency = 0;
+  bool as_unconstrained = false;
 };
 
 /// Maps a genus-0 mesh (holes allowed) onto the unit sphere so that vertex
@@ -89,5 +102,17 @@ Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& me
                                                                const std::vector<Eigen::Vector3d>& targets,
                                                                const ConstrainedParamOptions& options = {},
                                                                const ProgressFn& progress = {});
+
+/// parameterize_sphere_constrained(), made again with ConstrainedParamOptions::as_unconstrained
+/// when its efficiency is below retry_below x unconstrained_efficiency (the mesh's
+/// unconstrained map's), keeping the more efficient map (the first on a tie or when the
+/// retry fails). retry_below <= 0 or unconstrained_efficiency <= 0: no retry. The
+/// collection stages (steps 2 and 6, `add`) use it so that no member's map keeps far less of
+/// its own stretch efficiency than the constraints force. Deterministic for any thread count.
+Result<ConstrainedParamResult> constrained_param_or_retry(const TriMesh& mesh, const std::vector<int>& feature_vertices,
+                                                          const std::vector<Eigen::Vector3d>& targets,
+                                                          const ConstrainedParamOptions& options,
+                                                          double unconstrained_efficiency, double retry_below,
+                                                          const ProgressFn& progress = {});
 
 }  // namespace spherekit

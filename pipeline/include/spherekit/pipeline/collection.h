@@ -67,6 +67,10 @@ struct AddToCollectionJob {
   /// `seed_given` (the caller chose one).
   ConstrainedParamOptions options;
   bool seed_given = false;
+  /// ConsistentParamOptions::efficiency_retry for the new map (its unconstrained map is then
+  /// made too); the collection's recorded value unless `efficiency_retry_given`.
+  double efficiency_retry = 0.8;
+  bool efficiency_retry_given = false;
   /// Refine the new map's correspondence against the collection's reference member
   /// (refine_correspondence.h) when the collection was made with the refinement (its
   /// options say so, with the refinement's settings); false: never. Registered maps (`map`)

@@ -138,6 +138,9 @@ void print_add_summary(const pipeline::AddToCollectionResult& r, const pipeline:
   std::printf("%s -> %s (%zu features on the collection's locations)\n", job.mesh.c_str(), r.map_path.c_str(), r.features);
   std::printf("  efficiency %.4f, flipped faces %d, max feature error %.2g rad, %d paths, %d Steiner vertices\n",
               m.efficiency, m.flipped_faces, m.max_feature_angle, m.network.paths, m.network.steiner_vertices);
+  if (m.efficiency_retried)
+    std::printf("  made again as the unconstrained stage would (the first map's efficiency %.4f was below the retry bar)%s\n",
+                m.first_efficiency, m.as_unconstrained ? "" : "; the first kept");
   std::printf("  time %.2f s (wall %.2f s), peak memory %.0f MB\n", m.times.total, r.wall_seconds, peak_rss_mb());
 }
 
@@ -161,10 +164,16 @@ void print_consistent_summary(const pipeline::MakeCollectionResult& c, const std
   steps.add_row({"", "total", format_text("%.2f", r.times.total)});
   steps.print();
   std::printf("\n");
-  Table t({"mesh", "V", "efficiency", "flips", "feature err (rad)", "paths", "path len", "max len/geo", "Steiner", "time (s)"});
+  // "of own": the map's efficiency over its mesh's unconstrained map's ("retried": made again
+  // as the unconstrained stage would, ConsistentParamOptions::efficiency_retry).
+  Table t({"mesh", "V", "efficiency", "of own", "flips", "feature err (rad)", "paths", "path len", "max len/geo", "Steiner",
+           "time (s)"});
   for (size_t i = 0; i < c.members.size(); ++i) {
     const auto& m = r.maps[i];
-    t.add_row({c.members[i].name, std::to_string(c.members[i].mesh.V.rows()), format_text("%.4f", m.efficiency),
+    const double own = i < r.unconstrained_efficiency.size() ? r.unconstrained_efficiency[i] : 0.0;
+    std::string of_own = own > 0 ? format_text("%.2fx", m.efficiency / own) : "-";
+    if (m.efficiency_retried) of_own += " retried";
+    t.add_row({c.members[i].name, std::to_string(c.members[i].mesh.V.rows()), format_text("%.4f", m.efficiency), of_own,
                std::to_string(m.flipped_faces), format_text("%.1e", m.max_feature_angle), std::to_string(m.network.paths),
                format_text("%.4g", m.network.total_length), format_text("%.2f", m.network.max_ratio),
                std::to_string(m.network.steiner_vertices), format_text("%.2f", m.times.total)});

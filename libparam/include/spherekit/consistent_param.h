@@ -77,7 +77,7 @@ struct ConsistentParamResult {
   std::vector<Eigen::Vector3d> final_locations;    ///< F (step 5); equal to F' without refinement
   double reference_efficiency = 0;  ///< step 1 map's stretch efficiency
   /// Per mesh: its unconstrained map's stretch efficiency (the reference's is step 1's; all 0
-  /// when efficiency_retry is 0), what the retry and the refinement's floor compare against.
+  /// when efficiency_retry is 0), what the retry compares against.
   std::vector<double> unconstrained_efficiency;
   double joint_efficiency = 0;      ///< step 5: efficiency of the summed stretch (0 if not run)
   int joint_flips = 0;              ///< step 5 map's flipped faces (exact predicate; 0)

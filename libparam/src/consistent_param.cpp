@@ -89,14 +89,12 @@ Status constrained_maps(const std::vector<TriMesh>& meshes, const std::vector<st
         double& unconstrained = (*unconstrained_efficiency)[static_cast<size_t>(i)];
         if (options.efficiency_retry > 0 && unconstrained == 0) {
           // The mesh's own unconstrained map, once (step 2), with step 1's settings.
-          SphereParamOptions so = o.sphere;
-          so.align_rotation = false;
-          auto u = parameterize_sphere(meshes[static_cast<size_t>(i)], so, cancel);
+          auto u = own_unconstrained_efficiency(meshes[static_cast<size_t>(i)], o, cancel);
           if (!u.ok()) {
             reasons[static_cast<size_t>(j)] = u.status();
             return u.status().with_context(mesh_label(i));
           }
-          unconstrained = u->efficiency;
+          unconstrained = *u;
         }
         auto r = constrained_param_or_retry(meshes[static_cast<size_t>(i)], features[static_cast<size_t>(i)], targets,
                                             o, unconstrained, options.efficiency_retry, cancel);

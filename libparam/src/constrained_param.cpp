@@ -629,6 +629,14 @@ Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& me
   return Status(ErrorCode::SolverFailed, std::string(kSteinerFailure) + " (after " + std::to_string(attempt) + " network variants)");
 }
 
+Result<double> own_unconstrained_efficiency(const TriMesh& mesh, const ConstrainedParamOptions& options,
+                                            const ProgressFn& progress) {
+  SphereParamOptions so = options.sphere;
+  so.align_rotation = false;  // the efficiency does not depend on it
+  SPHEREKIT_ASSIGN_OR_RETURN(SphereParamResult u, parameterize_sphere(mesh, so, progress));
+  return u.efficiency;
+}
+
 // Why a retry, not the unconstrained stage's settings everywhere (issue 19, session 41): on a
 // generated limb shape (stress_meshes 3801 draw 7, member 0) mapped to its own unconstrained
 // map's feature images, a target the unconstrained optimum meets exactly, the collection

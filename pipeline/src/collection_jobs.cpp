@@ -18,7 +18,6 @@
 #include "spherekit/formats/sphere_map_io.h"
 #include "spherekit/metrics.h"
 #include "spherekit/propose_landmarks.h"
-#include "spherekit/sphere_param.h"
 #include "spherekit/pipeline/collection.h"
 #include "spherekit/pipeline/collection_update.h"
 #include "spherekit/pipeline/json.h"
@@ -476,27 +475,22 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
     double unconstrained = 0;
     if (retry > 0 && !o.as_unconstrained) {
       // The new mesh's own unconstrained map, what the retry compares against (as in steps 2 and 6).
-      SphereParamOptions so = o.sphere;
-      so.align_rotation = false;
-      auto u = parameterize_sphere(mesh, so, progress);
+      auto u = own_unconstrained_efficiency(mesh, o, progress);
       if (!u.ok()) return with_file(u.status(), a.mesh);
-      unconstrained = u->efficiency;
+      unconstrained = *u;
     }
     auto result = constrained_param_or_retry(mesh, fv, F, o, unconstrained, retry, progress);
     if (!result.ok()) return with_file(with_landmark_hint(result.status(), suspect_names, lm), a.mesh);
     out.map = std::move(result).value();
     SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
+    std::optional<RefinedMember> refined;
+    if (a.refine_correspondence) {
+      SPHEREKIT_ASSIGN_OR_RETURN(refined, refine_added_member(c, existing, mesh, fv, F, progress, &out.map));
+    }
+    // The entry once, of the map as kept (refined or not), in the order consistent writes it.
     e.result = map_entry_json(out.map);
     if (unconstrained > 0) e.result["unconstrained_efficiency"] = unconstrained;
-    if (a.refine_correspondence) {
-      SPHEREKIT_ASSIGN_OR_RETURN(std::optional<RefinedMember> refined,
-                                 refine_added_member(c, existing, mesh, fv, F, progress, &out.map));
-      if (refined) {
-        e.result = map_entry_json(out.map);
-        if (unconstrained > 0) e.result["unconstrained_efficiency"] = unconstrained;
-        e.result["correspondence_refinement"] = refinement_json(*refined);
-      }
-    }
+    if (refined) e.result["correspondence_refinement"] = refinement_json(*refined);
     u.write_map = [&](const std::string& path) { return formats::write_sphere_map(path, mesh, out.map.map); };
   }
   u.member = std::move(e);

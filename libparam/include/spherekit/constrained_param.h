@@ -103,6 +103,11 @@ Result<ConstrainedParamResult> parameterize_sphere_constrained(const TriMesh& me
                                                                const ConstrainedParamOptions& options = {},
                                                                const ProgressFn& progress = {});
 
+/// The stretch efficiency of the mesh's own unconstrained map made with `options.sphere` (no
+/// rotation): what constrained_param_or_retry() compares against (collections, `add`).
+Result<double> own_unconstrained_efficiency(const TriMesh& mesh, const ConstrainedParamOptions& options,
+                                            const ProgressFn& progress = {});
+
 /// parameterize_sphere_constrained(), made again with ConstrainedParamOptions::as_unconstrained
 /// when its efficiency is below retry_below x unconstrained_efficiency (the mesh's
 /// unconstrained map's), keeping the more efficient map (the first on a tie or when the

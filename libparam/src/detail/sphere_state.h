@@ -124,7 +124,7 @@ inline double gram_frobenius_numerator(double E11, double E22, double E12, doubl
 }
 
 /// Scratch memory for one vertex's 1-ring (one per thread).
-struct RingScratch {
+struct alignas(64) RingScratch {
   struct Face {
     Eigen::Vector3d qa, qb;  ///< sphere points of the other two corners, ccw after v
     Eigen::Vector3d n;       ///< qa x qb: the kernel constraint n . x > 0

@@ -475,6 +475,14 @@ TEST_CASE("propose_landmarks: left and right of differently posed symmetric memb
     }
   }
   CHECK(wrong == 0);
+  // Every member is right, so none is flagged: a left/right the sphere test settled against
+  // the cheapest assignment is flagged only when its signal is weak (agreement below 0.5).
+  for (std::size_t i = 1; i < meshes.size(); ++i) {
+    UNSCOPED_INFO("member " << i << " resolved " << r->members[i].mirror_resolved << " agreement "
+                            << r->members[i].sphere_agreement);
+    CHECK_FALSE(r->members[i].mirror_ambiguous);
+    if (r->members[i].mirror_resolved) CHECK(r->members[i].sphere_agreement >= 0.5);
+  }
 }
 
 TEST_CASE("propose_landmarks finds the six tips of an octahedron-like blob", "[param]") {

@@ -11,6 +11,12 @@
 namespace spherekit::cli {
 namespace {
 
+std::string fmt2(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f", x);
+  return buf;
+}
+
 struct LandmarksArgs {
   pipeline::LandmarksJob job;
   std::string report;
@@ -46,8 +52,13 @@ int run_landmarks(const LandmarksArgs& a) {
     const auto& m = p.members[i];
     double low = 1;
     for (double c : p.confidence[i]) low = std::min(low, c);
+    // A left/right the sphere test settled on a weak signal is also ambiguous: say both at once.
+    const std::string settled =
+        !m.mirror_resolved      ? ""
+        : m.mirror_ambiguous    ? ", left/right settled by orientation on a weak signal (agreement " + fmt2(m.sphere_agreement) + ")"
+                                : ", left/right settled by orientation";
     std::printf("  %s -> %s: cost %.4f, lowest confidence %.2f%s%s%s\n", a.job.meshes[i].c_str(), r->files[i].c_str(),
-                m.cost, low, m.mirror_resolved ? ", left/right settled by orientation" : "",
+                m.cost, low, settled.c_str(),
                 m.mirrored ? ", its cheapest match only reflected (a mirror image, or a pose of a near-symmetric shape: check)" : "", m.mirror_ambiguous ? ", left/right AMBIGUOUS: check on the page" : "");
   }
   return 0;

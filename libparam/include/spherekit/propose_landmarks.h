@@ -84,7 +84,8 @@ struct LandmarkMemberMatch {
   double orientation_agreement = 1;  ///< -1..1: how the chosen assignment's triples turn relative to the reference's
   bool mirror_resolved = false;    ///< the intrinsically best assignment was the mirror image and orientation chose the other
   bool mirrored = false;           ///< the member appears to be a mirror image of the reference (orientation disagrees)
-  bool mirror_ambiguous = false;   ///< orientation could not decide between two near-equal assignments
+  bool mirror_ambiguous = false;   ///< orientation could not decide between two near-equal assignments, or
+                                   ///< settled left/right against the cheapest on a weak signal (agreement < 0.5)
   bool sphere_checked = false;     ///< the choice was made by sphere maps (else by turns of triples)
   double sphere_agreement = 0;     ///< -1..1: signal correlation through the chosen assignment's map
   double sphere_runner_up = -2;    ///< the same for the next best candidate (-2: none)

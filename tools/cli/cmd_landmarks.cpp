@@ -52,11 +52,15 @@ int run_landmarks(const LandmarksArgs& a) {
     const auto& m = p.members[i];
     double low = 1;
     for (double c : p.confidence[i]) low = std::min(low, c);
-    // A left/right the sphere test settled on a weak signal is also ambiguous: say both at once.
-    const std::string settled =
-        !m.mirror_resolved      ? ""
-        : m.mirror_ambiguous    ? ", left/right settled by orientation on a weak signal (agreement " + fmt2(m.sphere_agreement) + ")"
-                                : ", left/right settled by orientation";
+    // A left/right settled by orientation but not clearly (a weak sphere signal, or a runner-up
+    // within the margin) is also flagged ambiguous: give the numbers that say why.
+    std::string settled;
+    if (m.mirror_resolved) {
+      settled = ", left/right settled by orientation";
+      if (m.mirror_ambiguous && m.sphere_checked)
+        settled += " not clearly (sphere agreement " + fmt2(m.sphere_agreement) +
+                   (m.sphere_runner_up > -2 ? ", runner-up " + fmt2(m.sphere_runner_up) : std::string()) + ")";
+    }
     std::printf("  %s -> %s: cost %.4f, lowest confidence %.2f%s%s%s\n", a.job.meshes[i].c_str(), r->files[i].c_str(),
                 m.cost, low, settled.c_str(),
                 m.mirrored ? ", its cheapest match only reflected (a mirror image, or a pose of a near-symmetric shape: check)" : "", m.mirror_ambiguous ? ", left/right AMBIGUOUS: check on the page" : "");

@@ -1,5 +1,6 @@
 // White-box checks of the stretch optimizer's per-vertex energy (libparam/src/stretch_optimizer.cpp):
 // independence of face numbering and the size of the anti-cruft term (issue 20); a pass's work bound.
+#include <thread>
 #include <catch2/catch.hpp>
 
 #include <Eigen/SVD>
@@ -545,6 +546,34 @@ TEST_CASE("the worker pool runs every item of a loop once, for any size, chunk a
         CHECK(wrong == 0);
         CHECK(bad_thread.load() == 0);
       }
+    }
+  }
+}
+
+TEST_CASE("the worker pool runs a loop's side task exactly once, on the calling thread, while the items run",
+          "[param][threads]") {
+  // optimize_all hands a colour class's bookkeeping to the next class's loop as its side task
+  // (worker_pool.h): it must run once whatever the loop's size (empty, serial or parallel),
+  // on the caller (it writes the caller's lists without locks), and every item still once.
+  for (int threads : {1, 2, 3}) {
+    WorkerPool pool(threads);
+    const std::thread::id caller = std::this_thread::get_id();
+    for (int n : {0, 1, 2, 7, 64, 1001}) {
+      std::vector<std::atomic<int>> visits(static_cast<size_t>(n));
+      int side_runs = 0;
+      bool side_on_caller = true;
+      pool.parallel_for(
+          n, 1, 2, [&](int i, int) { visits[static_cast<size_t>(i)].fetch_add(1); },
+          [&] {
+            ++side_runs;
+            side_on_caller = side_on_caller && std::this_thread::get_id() == caller;
+          });
+      int wrong = 0;
+      for (auto& v : visits) wrong += v.load() != 1;
+      INFO("threads " << threads << " n " << n);
+      CHECK(side_runs == 1);
+      CHECK(side_on_caller);
+      CHECK(wrong == 0);
     }
   }
 }

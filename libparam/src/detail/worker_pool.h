@@ -43,9 +43,18 @@ class WorkerPool {
   /// Calls body(i, thread) for every i in [0, n), thread in [0, threads()); chunks of
   /// `chunk` items. Serial when n is small or there are no workers: waking threads costs
   /// more than it saves below a few hundred cheap items.
-  void parallel_for(int n, int chunk, int min_parallel, const std::function<void(int, int)>& body) {
-    if (n <= 0) return;
+  ///
+  /// `side`, if given, is serial work of the caller's that touches nothing the body reads or
+  /// writes: the calling thread runs it once the loop is open, while the workers start on
+  /// the items, and then joins them (it is run exactly once, also when the loop is serial).
+  void parallel_for(int n, int chunk, int min_parallel, const std::function<void(int, int)>& body,
+                    const std::function<void()>& side = {}) {
+    if (n <= 0) {
+      if (side) side();
+      return;
+    }
     if (workers_.empty() || n < min_parallel) {
+      if (side) side();
       for (int i = 0; i < n; ++i) body(i, 0);
       return;
     }
@@ -65,6 +74,7 @@ class WorkerPool {
       wake = sleeping_ > 0;
     }
     if (wake) start_cv_.notify_all();
+    if (side) side();
     run_chunks(0);
     // Wait only for the workers that joined while the loop was open: they are running
     // chunks now. One still waking up (tens of microseconds on a virtual machine, longer

@@ -583,7 +583,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
         rep.efficiency_before = rep.efficiency_after = m0.efficiency;
         const double bar = std::min(m0.efficiency, template_efficiency);
         const VertexFaces mi_faces(mi);
-        const Result<FilledMesh> mi_closed = options.stretch_passes > 0 ? fill_holes(mi) : Result<FilledMesh>(FilledMesh{});
+        const Result<FilledMesh> mi_closed = fill_holes(mi);  // the polish's and the flow's relaxation's
         const std::vector<int> spread = surface_samples(mi, fi, options.samples);
         int samples = options.samples;
         for (int round = 0; round < options.rounds; ++round) {
@@ -606,6 +606,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           RowMat3d S;
           const int round_samples = samples;
           int left_out = 0;
+          int round_relaxations = 0;
           auto finished = [&] { return st.ok() || st.code() == ErrorCode::Cancelled || !keep_going(); };
           for (int attempt = 0; attempt < 2; ++attempt) {
             if (attempt == 1) {
@@ -630,7 +631,17 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
               for (int w : W)  // a sample in a hole of the template (or left out) has no partner: it is not a target
                 if (inside[static_cast<size_t>(w)]) fv.push_back(w), targets.push_back(Sc.row(w).transpose());
               S = cur;
-              st = detail::warp_features_to_targets(mi.V, mi.F, fv, targets, {}, &S);
+              // Where the flow stalls (a sliver it cannot carry however small the step), one
+              // stretch pass with the features and samples held where they are spreads the
+              // mesh out and the flow goes on, as the constrained stage's dense features do.
+              const detail::WarpRelaxFn relax = [&](RowMat3d* R) -> Status {
+                const Result<bool> r = polish_stretch(mi_closed, fv, 1, keep_going, R);
+                if (!r.ok()) return r.status();
+                return *r ? Status() : Status(ErrorCode::SolverFailed, "a hole's loop is not star-shaped on the sphere");
+              };
+              detail::WarpStats ws;
+              st = detail::warp_features_to_targets(mi.V, mi.F, fv, targets, {}, &S, &ws, relax);
+              round_relaxations = ws.relaxed;
               if (finished()) break;
             }
             if (finished()) break;
@@ -672,6 +683,7 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
           rep.rounds = round + 1;
           rep.samples = samples;
           rep.folded_samples_left_out = left_out;
+          rep.flow_relaxations += round_relaxations;
           rep.energy_after = e1;
           rep.crushed_faces = crushed;
           rep.efficiency_after = m1.efficiency;

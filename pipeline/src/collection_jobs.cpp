@@ -178,6 +178,7 @@ Json refinement_json(const RefinedMember& m) {
   j["energy_after"] = m.energy_after;
   j["crushed_faces"] = m.crushed_faces;
   j["folded_samples_left_out"] = m.folded_samples_left_out;
+  j["flow_relaxations"] = m.flow_relaxations;
   j["efficiency_before"] = m.efficiency_before;
   j["efficiency_after"] = m.efficiency_after;
   return j;

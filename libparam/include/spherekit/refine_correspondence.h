@@ -80,6 +80,9 @@ struct RefinedMember {
   /// Samples of the last round taken left out because the fit folds the member's map around
   /// them (only after the flow failed with every sample count; 0 otherwise).
   int folded_samples_left_out = 0;
+  /// Stretch passes the flows of the rounds taken made where a flow stalled (features and
+  /// samples held; the flow then went on).
+  int flow_relaxations = 0;
   /// Stretch efficiency of the member's map before and after (metrics.h). A round that
   /// would leave less than 0.8x the lower of the member's starting efficiency and the
   /// template's is not taken (agreeing maps carry the template's distortion).

@@ -947,4 +947,3 @@ int optimize_all(SphereState& st, const OptimizerSettings& s, std::uint64_t pass
 }
 
 }  // namespace spherekit::detail
-

@@ -1,11 +1,12 @@
 // White-box checks of the stretch optimizer's per-vertex energy (libparam/src/stretch_optimizer.cpp):
-// independence of face numbering and the size of the anti-cruft term (issue 20); a pass's work bound.
-#include <thread>
+// independence of face numbering and the size of the anti-cruft term (issue 20); a pass's work bound;
+// the worker pool's loops and side tasks.
 #include <catch2/catch.hpp>
 
 #include <Eigen/SVD>
 #include <atomic>
 #include <cmath>
+#include <thread>
 #include <vector>
 
 #include "detail/sphere_embedding.h"

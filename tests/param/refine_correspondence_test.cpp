@@ -84,6 +84,18 @@ TwistCase twist_case() {
   return c;
 }
 
+// The copy's map twisted by `angle` about the feature, refined against the template with one
+// thread; *maps receives {template's map, refined map}.
+Result<RefineCorrespondenceResult> refine_twisted_copy(const TwistCase& c, const RowMat3d& S1,
+                                                       std::vector<RowMat3d>* maps) {
+  std::vector<TriMesh> meshes{c.tmpl, c.copy};
+  std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
+  *maps = {c.St, S1};
+  RefineCorrespondenceOptions o;
+  o.threads = 1;
+  return refine_correspondence(meshes, features, *maps, o);
+}
+
 }  // namespace
 
 TEST_CASE("refinement brings a twisted map of an isometric copy back to the template's", "[refine]") {
@@ -93,13 +105,8 @@ TEST_CASE("refinement brings a twisted map of an isometric copy back to the temp
   REQUIRE(count_flipped_faces(c.copy.F, S1) == 0);
   const double before = copy_error(c.tmpl, c.St, c.copy, S1);
   REQUIRE(before > 0.02);  // the twist is a real disagreement
-
-  std::vector<TriMesh> meshes{c.tmpl, c.copy};
-  std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
-  std::vector<RowMat3d> maps{c.St, S1};
-  RefineCorrespondenceOptions o;
-  o.threads = 1;
-  auto r = refine_correspondence(meshes, features, maps, o);
+  std::vector<RowMat3d> maps;
+  auto r = refine_twisted_copy(c, S1, &maps);
   REQUIRE(r.ok());
   const RefinedMember& m = r->members[1];
   INFO(m.note);
@@ -348,12 +355,8 @@ TEST_CASE("a flow that stalls is relaxed and goes on: the refined map stays bije
   const RowMat3d S1 = twisted(c.St, axis, 1.5);
   REQUIRE(count_flipped_faces(c.copy.F, S1) == 0);
   const double before = copy_error(c.tmpl, c.St, c.copy, S1);
-  std::vector<TriMesh> meshes{c.tmpl, c.copy};
-  std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
-  std::vector<RowMat3d> maps{c.St, S1};
-  RefineCorrespondenceOptions o;
-  o.threads = 1;
-  auto r = refine_correspondence(meshes, features, maps, o);
+  std::vector<RowMat3d> maps;
+  auto r = refine_twisted_copy(c, S1, &maps);
   REQUIRE(r.ok());
   const RefinedMember& m = r->members[1];
   INFO(m.note);

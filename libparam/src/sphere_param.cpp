@@ -26,6 +26,7 @@ std::string options_digest(const SphereParamOptions& o) {
                 static_cast<unsigned long long>(o.seed), o.effort, o.align_rotation ? 1 : 0);
   std::string printed = buf;
   if (o.precise_layout) printed += ";precise;fine_split=0.95;layout_floor=0.03;pass_cap=64";  // absent when off: the collection stages' digests are as before
+  if (o.block_vertices > 0) printed += ";blocks=" + std::to_string(o.block_vertices);  // likewise
   return detail::options_digest_hex(printed);
 }
 
@@ -91,6 +92,8 @@ Result<SphereParamResult> parameterize_sphere(const TriMesh& mesh, const SphereP
   // (issue 20: tentacle blob 0.1127 -> 0.1272 with the same optimizer).
   pmo.normal_weight = 0.02;
   pmo.memoryless = true;
+  pmo.threads = options.threads;
+  pmo.block_vertices = options.block_vertices;
   // Hole faces take full part in the simplification (only the optimizer down-weights
   // them, as the reference does): their geometry shapes the coarse levels like any other.
   SPHEREKIT_ASSIGN_OR_RETURN(ProgressiveMesh pm, build_progressive_mesh(P, closed.F, pmo, progress));

@@ -68,6 +68,7 @@ Json sphere_param_options_json(const SphereParamOptions& o) {
   j["hole_weight"] = o.hole_weight;
   j["hole_shape_weight"] = o.hole_shape_weight;
   j["precise_layout"] = o.precise_layout;
+  j["block_vertices"] = o.block_vertices;
   return j;
 }
 

@@ -404,6 +404,10 @@ TEST_CASE("param: a constrained map takes the collection stages' anti-cruft and 
   CHECK(hole_shape(constrained + " --hole-shape-weight 0.1") == 0.1);
   CHECK(option("", "precise_layout").get<bool>());
   CHECK_FALSE(option(constrained, "precise_layout").get<bool>());
+  // The simplification in blocks likewise, and its flag.
+  CHECK(option("", "block_vertices").get<int>() == spherekit::SphereParamOptions{}.block_vertices);
+  CHECK(option(" --block-vertices 0", "block_vertices").get<int>() == 0);
+  CHECK(option(constrained, "block_vertices").get<int>() == 0);
   // The path network's ranking (path_network.cpp, rank_cost): on unless switched off.
   CHECK(option(constrained, "arc_ranking").get<bool>());
   CHECK_FALSE(option(constrained + " --no-arc-ranking", "arc_ranking").get<bool>());

@@ -39,6 +39,42 @@ bool is_closed_manifold(const std::vector<std::array<int, 3>>& F) {
   return true;
 }
 
+// A valid hierarchy: it ends in a tetrahedron, removes every other vertex once, and undoing
+// the collapses in reverse order restores the input faces exactly.
+void check_replays_exactly(const ProgressiveMesh& pm, const TriMesh& m) {
+  CHECK(pm.base_vertices.size() == 4);
+  CHECK(pm.base_faces.size() == 4);
+  CHECK(pm.collapses.size() == static_cast<size_t>(m.V.rows() - 4));
+  std::vector<std::array<int, 3>> F(static_cast<size_t>(m.F.rows()));
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) F[static_cast<size_t>(f)] = {m.F(f, 0), m.F(f, 1), m.F(f, 2)};
+  std::vector<char> alive(F.size(), 1);
+  auto base = replay_forward(pm, F, alive);
+  CHECK(base.size() == 4);
+  CHECK(is_closed_manifold(base));
+  // Every vertex is removed at most once and never a base vertex.
+  std::set<int> removed;
+  for (const auto& c : pm.collapses) {
+    CHECK(removed.insert(c.vt).second);
+    CHECK(c.vl != c.vr);
+  }
+  for (int v : pm.base_vertices) CHECK(removed.count(v) == 0);
+  // Undo in reverse order: restores the input faces exactly.
+  for (int i = static_cast<int>(pm.collapses.size()) - 1; i >= 0; --i) {
+    const auto& c = pm.collapses[static_cast<size_t>(i)];
+    for (int j = c.moved_begin; j < c.moved_end; ++j)
+      for (int& v : F[static_cast<size_t>(pm.moved_faces[static_cast<size_t>(j)])])
+        if (v == c.vs) v = c.vt;
+    for (int s = 0; s < 2; ++s) {
+      F[static_cast<size_t>(c.removed[static_cast<size_t>(s)])] = pm.removed_corners[2 * static_cast<size_t>(i) + static_cast<size_t>(s)];
+      alive[static_cast<size_t>(c.removed[static_cast<size_t>(s)])] = 1;
+    }
+  }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    CHECK(alive[static_cast<size_t>(f)]);
+    CHECK(F[static_cast<size_t>(f)] == std::array<int, 3>{m.F(f, 0), m.F(f, 1), m.F(f, 2)});
+  }
+}
+
 }  // namespace
 
 TEST_CASE("progressive mesh of a genus-0 mesh ends in a tetrahedron and replays exactly", "[param][pm]") {
@@ -54,37 +90,7 @@ TEST_CASE("progressive mesh of a genus-0 mesh ends in a tetrahedron and replays 
     opt.normal_weight = memoryless ? 0.02 : 0.0;
     auto pm = build_progressive_mesh(P, m.F, opt);
     REQUIRE(pm.ok());
-    CHECK(pm->base_vertices.size() == 4);
-    CHECK(pm->base_faces.size() == 4);
-    CHECK(pm->collapses.size() == static_cast<size_t>(m.V.rows() - 4));
-    std::vector<std::array<int, 3>> F(static_cast<size_t>(m.F.rows()));
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f) F[static_cast<size_t>(f)] = {m.F(f, 0), m.F(f, 1), m.F(f, 2)};
-    std::vector<char> alive(F.size(), 1);
-    auto base = replay_forward(*pm, F, alive);
-    CHECK(base.size() == 4);
-    CHECK(is_closed_manifold(base));
-    // Every vertex is removed at most once and never a base vertex.
-    std::set<int> removed;
-    for (const auto& c : pm->collapses) {
-      CHECK(removed.insert(c.vt).second);
-      CHECK(c.vl != c.vr);
-    }
-    for (int v : pm->base_vertices) CHECK(removed.count(v) == 0);
-    // Undo in reverse order: restores the input faces exactly.
-    for (int i = static_cast<int>(pm->collapses.size()) - 1; i >= 0; --i) {
-      const auto& c = pm->collapses[static_cast<size_t>(i)];
-      for (int j = c.moved_begin; j < c.moved_end; ++j)
-        for (int& v : F[static_cast<size_t>(pm->moved_faces[static_cast<size_t>(j)])])
-          if (v == c.vs) v = c.vt;
-      for (int s = 0; s < 2; ++s) {
-        F[static_cast<size_t>(c.removed[static_cast<size_t>(s)])] = pm->removed_corners[2 * static_cast<size_t>(i) + static_cast<size_t>(s)];
-        alive[static_cast<size_t>(c.removed[static_cast<size_t>(s)])] = 1;
-      }
-    }
-    for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
-      CHECK(alive[static_cast<size_t>(f)]);
-      CHECK(F[static_cast<size_t>(f)] == std::array<int, 3>{m.F(f, 0), m.F(f, 1), m.F(f, 2)});
-    }
+    check_replays_exactly(*pm, m);
   }
 }
 
@@ -220,4 +226,45 @@ TEST_CASE("progressive mesh: model planes", "[param][pm]") {
   auto refused = build_progressive_mesh(P, a.F, bad);
   REQUIRE_FALSE(refused.ok());
   CHECK(refused.status().code() == ErrorCode::InvalidArgument);
+}
+
+// Parallel fine levels (ProgressiveMeshOptions::block_vertices): the blocks' collapses are
+// replayed on the whole mesh, so the hierarchy must be as valid as the plain greedy's, and
+// the blocks come from the mesh alone, so it must not depend on the thread count.
+TEST_CASE("progressive mesh in blocks: valid, the same for any thread count, the fine levels from the blocks",
+          "[param][pm]") {
+  TriMesh m = test::random_blob(4, 5);  // 2562 vertices: 8 blocks, then 2
+  ProgressiveMeshOptions opt;
+  opt.memoryless = true;
+  opt.normal_weight = 0.02;
+  auto plain = build_progressive_mesh(m.V, m.F, opt);
+  REQUIRE(plain.ok());
+  opt.block_vertices = 300;
+  std::vector<ProgressiveMesh> runs;
+  for (int threads : {1, 3}) {
+    opt.threads = threads;
+    auto pm = build_progressive_mesh(m.V, m.F, opt);
+    REQUIRE(pm.ok());
+    check_replays_exactly(*pm, m);
+    CHECK(pm->forced_collapses == 0);
+    runs.push_back(std::move(*pm));
+  }
+  REQUIRE(runs[0].collapses.size() == runs[1].collapses.size());
+  for (size_t i = 0; i < runs[0].collapses.size(); ++i) {
+    CHECK(runs[0].collapses[i].vt == runs[1].collapses[i].vt);
+    CHECK(runs[0].collapses[i].vs == runs[1].collapses[i].vs);
+  }
+  CHECK(runs[0].moved_faces == runs[1].moved_faces);
+  // The blocks made the fine levels: the order differs from the plain greedy's early on.
+  size_t same_prefix = 0;
+  while (same_prefix < plain->collapses.size() && plain->collapses[same_prefix].vt == runs[0].collapses[same_prefix].vt &&
+         plain->collapses[same_prefix].vs == runs[0].collapses[same_prefix].vs)
+    ++same_prefix;
+  CHECK(same_prefix < runs[0].collapses.size() / 4);
+  // A mesh of fewer than two blocks' vertices is simplified as one.
+  opt.block_vertices = static_cast<int>(m.V.rows()) / 2 + 1;
+  auto one = build_progressive_mesh(m.V, m.F, opt);
+  REQUIRE(one.ok());
+  REQUIRE(one->collapses.size() == plain->collapses.size());
+  for (size_t i = 0; i < plain->collapses.size(); ++i) CHECK(one->collapses[i].vt == plain->collapses[i].vt);
 }

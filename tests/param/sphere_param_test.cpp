@@ -136,6 +136,23 @@ TEST_CASE("results are deterministic, also across thread counts", "[param][spher
   REQUIRE(e.ok());
   CHECK(d->map.S == e->map.S);
   CHECK(d->map.S != a->map.S);  // the effort did change the map
+  // The progressive mesh's fine levels simplified in blocks (8 here, as on meshes of 65k
+  // vertices with the default size), in parallel: the blocks depend on the mesh alone.
+  one.effort = 2;
+  one.block_vertices = 300;
+  two.block_vertices = 300;
+  three.effort = 2;
+  three.block_vertices = 300;
+  auto f = parameterize_sphere(m, one);
+  auto g = parameterize_sphere(m, two);
+  auto h = parameterize_sphere(m, three);
+  REQUIRE(f.ok());
+  REQUIRE(g.ok());
+  REQUIRE(h.ok());
+  CHECK(f->map.S == g->map.S);
+  CHECK(f->map.S == h->map.S);
+  CHECK(f->map.S != a->map.S);  // the blocks did change the hierarchy
+  CHECK(f->flipped_faces == 0);
 }
 
 TEST_CASE("progress callback can cancel", "[param][sphere]") {

@@ -268,6 +268,9 @@ void add_sphere_param_options(CLI::App& command, SphereParamOptions& o) {
   command.add_option("--hole-shape-weight", o.hole_shape_weight,
                      "weight of the shape term that keeps hole faces from becoming slivers (shape-defining)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
+  command.add_option("--block-vertices", o.block_vertices,
+                     "simplify meshes of 2x this many vertices in blocks of this many first, in parallel; 0: one greedy (shape-defining)")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
   add_hidden_alias(command, "--regularizer_weight", o.regularizer_weight);
   add_hidden_alias(command, "--hole_weight", o.hole_weight);
   add_hidden_alias(command, "--hole_shape_weight", o.hole_shape_weight);

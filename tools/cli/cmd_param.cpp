@@ -54,10 +54,12 @@ int run_param(const ParamArgs& a) {
   job.constrained = a.flags.constrained;
   // A constrained map is a collection stage's map (one `consistent` or `add` would make):
   // it takes the collection stages' anti-cruft and hole shape weights unless the flags say
-  // otherwise (and, like them, no coarse-layout precision: SphereParamOptions::precise_layout).
+  // otherwise (and, like them, no coarse-layout precision, SphereParamOptions::precise_layout,
+  // and no simplification in blocks, block_vertices).
   if (!job.features.empty() && !a.regularizer_given) job.options.regularizer_weight = kCollectionRegularizerWeight;
   if (!job.features.empty() && !a.hole_shape_given) job.options.hole_shape_weight = kCollectionHoleShapeWeight;
   if (!job.features.empty()) job.options.precise_layout = false;
+  if (!job.features.empty()) job.options.block_vertices = 0;
   ProgressRenderer progress(a.quiet);
   auto r = [&] {
     ComputeScope graceful_cancel;

@@ -79,6 +79,16 @@ struct ProgressiveMeshOptions {
   /// fold-overs for the rest (bunny's coarsest adaptive LOD: 22.7 dB). Off by default: the
   /// parameterization's simplification stays as it was.
   bool degenerate_faces_free = false;
+  /// Parallel fine levels (memoryless quadrics, no constraint edges or kept vertices): with
+  /// block_vertices > 0 and a mesh of at least 2 x that many vertices, the mesh is first cut
+  /// into spatial blocks of about this many vertices; each block is simplified on its own
+  /// (blocks in parallel) by the same greedy, its vertices next to another block held, until
+  /// block_fraction of its other vertices remain; then the greedy goes on over the whole
+  /// mesh. The blocks depend on the mesh only, so the result does not depend on `threads`.
+  /// 0 (default): one greedy over the whole mesh.
+  int block_vertices = 0;
+  double block_fraction = 0.2;
+  int threads = 1;  ///< threads for the blocks (0 = all cores)
 };
 
 /// Builds the progressive mesh of a closed, manifold, genus-0 triangle mesh whose vertex

@@ -25,7 +25,7 @@ std::string options_digest(const SphereParamOptions& o) {
   std::snprintf(buf, sizeof buf, "reg=%.17g;hole=%.17g;hshape=%.17g;seed=%llu;effort=%d;align=%d", o.regularizer_weight, o.hole_weight, o.hole_shape_weight,
                 static_cast<unsigned long long>(o.seed), o.effort, o.align_rotation ? 1 : 0);
   std::string printed = buf;
-  if (o.precise_layout) printed += ";precise;fine_split=0.95;layout_floor=0.03;pass_cap=64";  // absent when off: the collection stages' digests are as before
+  if (o.precise_layout) printed += ";precise;fine_split=0.95;layout_floor=0.03;pass_cap=64;outlier_polish";  // absent when off: the collection stages' digests are as before
   if (o.block_vertices > 0) printed += ";blocks=" + std::to_string(o.block_vertices);  // likewise
   return detail::options_digest_hex(printed);
 }

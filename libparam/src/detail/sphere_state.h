@@ -56,6 +56,9 @@ struct OptimizerSettings {
   int vsplit_nei_iter = 0;     ///< local optimizations of its neighbours
   int global_iter = 3;         ///< passes (rounds until no vertex is active) per level
   int final_iter = 3;          ///< passes at full resolution (on the measured energy)
+  /// After the final pass, move the vertices of faces stretched more than 10x the 99th
+  /// percentile to lower their rings' largest stretch (Refiner::polish_outlier_faces).
+  bool outlier_polish = false;
   double movetol = 1e-3;       ///< a vertex stays active while its credit exceeds this
   double movetol_rel = 0;      ///< if > 0: threshold = min(movetol, movetol_rel * shortest chord to a neighbour)
   /// Coarse layout precision (SphereParamOptions::precise_layout): levels of at most

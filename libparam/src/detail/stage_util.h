@@ -30,6 +30,7 @@ inline OptimizerSettings optimizer_settings(const SphereParamOptions& o) {
     s.area_floor_rel = 0.03;
     s.pass_work_cap = 64;
   }
+  s.outlier_polish = o.precise_layout;  // the unconstrained stage's, as the settings above
   s.seed = o.seed;
   s.threads = o.threads;
   return s;

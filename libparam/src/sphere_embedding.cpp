@@ -568,5 +568,3 @@ Status optimize_in_place(const RowMatXd& P, const RowMat3i& F, const std::vector
 }
 
 }  // namespace spherekit::detail
-
-

@@ -66,8 +66,9 @@ struct SphereParamOptions {
   /// The progressive mesh's fine levels in parallel (ProgressiveMeshOptions::block_vertices):
   /// a mesh of at least twice this many vertices is first simplified in spatial blocks of
   /// about this many, each by the same greedy on its own, its vertices next to another block
-  /// held, to a fifth of its vertices, in rounds while two blocks remain; then as one. The
-  /// blocks depend on the mesh only (results do not depend on `threads`). The serial greedy
+  /// held, until a fifth of their vertices remain in all (one cost cut for all blocks), in
+  /// rounds while two blocks remain; then as one. The blocks depend on the mesh only
+  /// (results do not depend on `threads`). The serial greedy
   /// was a quarter of igea's time with one thread and a third with two (issue 20); blocks
   /// also stay in cache: igea's simplification 1.9-2.1 -> 1.4 s with one thread, 1.8-1.95 ->
   /// 0.95-1.2 s with two; efficiency within -0.0022..+0.0020 of the single greedy on 24 meshes.

@@ -225,7 +225,7 @@ Result<SphereMapMetrics> evaluate_sphere_map(const TriMesh& mesh, const RowMat3d
                                                          mesh.V.row(F(f, 2)).data(), q0, q1, q2);
     const bool ok = t.area_domain > kFloor;
     // Singular values of J: Gamma^2, gamma^2 = (a + c +- sqrt((a - c)^2 + 4 b^2)) / 2.
-    const double disc = std::sqrt(std::max((t.a - t.c) * (t.a - t.c) + 4.0 * t.b * t.b, 0.0));
+    const double disc = detail::singular_disc(t);
     const double G2 = 0.5 * (t.a + t.c + disc);
     const double g2 = std::max(0.5 * (t.a + t.c - disc), 0.0);
     double face_conf = std::numeric_limits<double>::infinity();

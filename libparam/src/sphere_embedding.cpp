@@ -182,8 +182,8 @@ class Refiner {
   }
 
  private:
-  // The largest stretch of v's real faces with v at x, and their measured L2 energy (chord
-  // area x (a + c) / 2, the sum the efficiency is made of).
+  // The largest stretch of v's real faces with v at x, and their L2 stretch energy over the
+  // sphere (chord area x (a + c) / 2).
   void ring_stretch(int v, const Eigen::Vector3d& x, double* worst, double* energy) const {
     *worst = 0, *energy = 0;
     for (int f : st_.vf[static_cast<size_t>(v)]) {
@@ -194,20 +194,19 @@ class Refiner {
       *energy += e;
     }
   }
-  // Face f's largest singular value (map chord triangle -> surface) and measured L2 energy,
-  // with v at x.
+  // Face f's largest singular value (map chord triangle -> surface) and L2 stretch energy
+  // over the sphere, with v at x.
   void face_stretch(int f, int v, const Eigen::Vector3d& x, double* s1, double* energy) const {
     const auto& c = st_.F[static_cast<size_t>(f)];
     const double* q[3];
     for (int k = 0; k < 3; ++k) q[k] = c[k] == v ? x.data() : st_.S.row(c[k]).data();
-    Eigen::Vector3d p[3];
-    for (int k = 0; k < 3; ++k) p[k] = st_.P->row(c[k]).head<3>().transpose();
-    const StretchTerms t = stretch_terms(p[0].data(), p[1].data(), p[2].data(), q[0], q[1], q[2]);
+    const StretchTerms t = stretch_terms(st_.P->row(c[0]).data(), st_.P->row(c[1]).data(), st_.P->row(c[2]).data(),
+                                         q[0], q[1], q[2]);  // one model: a row is its 3 coordinates
     if (!(t.area_domain > 0)) {
       *s1 = *energy = std::numeric_limits<double>::infinity();
       return;
     }
-    *s1 = std::sqrt(0.5 * ((t.a + t.c) + std::sqrt((t.a - t.c) * (t.a - t.c) + 4 * t.b * t.b)));
+    *s1 = std::sqrt(0.5 * (t.a + t.c + singular_disc(t)));
     *energy = t.area_domain * 0.5 * (t.a + t.c);
   }
 
@@ -217,8 +216,8 @@ class Refiner {
   // optimum happens to put it: generated quadruped_r96-holes gave Linf 29.5 or 1071 with
   // progressive meshes of equal quality. Each vertex of a face stretched more than 10x the
   // 99th percentile is moved, within its kernel (exact predicate), to lower its ring's
-  // largest stretch, as long as the measured L2 energy (chord area x stretch^2 over the real
-  // faces) grows by at most 1e-7 of the total over all moves.
+  // largest stretch, as long as the L2 stretch energy over the sphere (chord area x
+  // stretch^2 over the real faces) grows by at most 1e-7 of the total over all moves.
   void polish_outlier_faces() {
     if (st_.models != 1) return;
     const int nf = static_cast<int>(st_.F.size());

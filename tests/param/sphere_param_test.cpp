@@ -114,45 +114,31 @@ TEST_CASE("non-genus-0 inputs are refused with a clear error", "[param][sphere]"
 
 TEST_CASE("results are deterministic, also across thread counts", "[param][sphere]") {
   TriMesh m = test::random_blob(4, 5);  // 2562 vertices: large enough for parallel rounds
-  SphereParamOptions one, two;
-  one.threads = 1;
-  two.threads = 2;
-  auto a = parameterize_sphere(m, one);
-  auto b = parameterize_sphere(m, one);
-  auto c = parameterize_sphere(m, two);
-  REQUIRE(a.ok());
-  REQUIRE(b.ok());
-  REQUIRE(c.ok());
-  CHECK(a->map.S == b->map.S);  // bitwise equality
-  CHECK(a->map.S == c->map.S);
+  auto map = [&](int threads, int effort, int block_vertices) {
+    SphereParamOptions o;
+    o.threads = threads;
+    o.effort = effort;
+    o.block_vertices = block_vertices;
+    auto r = parameterize_sphere(m, o);
+    REQUIRE(r.ok());
+    return std::move(*r);
+  };
+  const int plain = SphereParamOptions{}.block_vertices;  // above this mesh's size: one greedy
+  const SphereParamResult a = map(1, 2, plain), b = map(1, 2, plain), c = map(2, 2, plain);
+  CHECK(a.map.S == b.map.S);  // bitwise equality
+  CHECK(a.map.S == c.map.S);
   // Effort 3 also moves each new vertex's neighbours (the vertex splits placed in parallel
   // then claim 2-rings); three threads split the runs of splits differently again.
-  one.effort = 3;
-  SphereParamOptions three = one;
-  three.threads = 3;
-  auto d = parameterize_sphere(m, one);
-  auto e = parameterize_sphere(m, three);
-  REQUIRE(d.ok());
-  REQUIRE(e.ok());
-  CHECK(d->map.S == e->map.S);
-  CHECK(d->map.S != a->map.S);  // the effort did change the map
+  const SphereParamResult d = map(1, 3, plain), e = map(3, 3, plain);
+  CHECK(d.map.S == e.map.S);
+  CHECK(d.map.S != a.map.S);  // the effort did change the map
   // The progressive mesh's fine levels simplified in blocks (8 here, as on meshes of 65k
   // vertices with the default size), in parallel: the blocks depend on the mesh alone.
-  one.effort = 2;
-  one.block_vertices = 300;
-  two.block_vertices = 300;
-  three.effort = 2;
-  three.block_vertices = 300;
-  auto f = parameterize_sphere(m, one);
-  auto g = parameterize_sphere(m, two);
-  auto h = parameterize_sphere(m, three);
-  REQUIRE(f.ok());
-  REQUIRE(g.ok());
-  REQUIRE(h.ok());
-  CHECK(f->map.S == g->map.S);
-  CHECK(f->map.S == h->map.S);
-  CHECK(f->map.S != a->map.S);  // the blocks did change the hierarchy
-  CHECK(f->flipped_faces == 0);
+  const SphereParamResult f = map(1, 2, 300), g = map(2, 2, 300), h = map(3, 2, 300);
+  CHECK(f.map.S == g.map.S);
+  CHECK(f.map.S == h.map.S);
+  CHECK(f.map.S != a.map.S);  // the blocks did change the hierarchy
+  CHECK(f.flipped_faces == 0);
 }
 
 TEST_CASE("progress callback can cancel", "[param][sphere]") {

@@ -59,7 +59,7 @@ struct SphereParamOptions {
   /// It also polishes outlier faces after the final pass: the vertices of a face stretched
   /// more than 10x the 99th percentile (a sliver of scan or iso-surface debris, which the L2
   /// energy weighs by its near-zero area) move within their kernels to lower their rings'
-  /// largest stretch, spending at most 1e-7 of the measured L2 energy (generated shapes:
+  /// largest stretch, spending at most 1e-7 of the L2 stretch energy over the sphere (generated shapes:
   /// quadruped_r96-holes Linf 1071 -> 10.8, biped_r160 110 -> 11.2, hand_r160 130 -> 17.4, each
   /// efficiency up by 3e-7..8e-6; the shared dev meshes have no such face and do not change).
   bool precise_layout = true;

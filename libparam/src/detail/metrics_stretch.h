@@ -57,4 +57,9 @@ inline StretchTerms stretch_terms(const double* p0, const double* p1, const doub
   return r;
 }
 
+/// sqrt((a - c)^2 + 4 b^2): the singular values of J are sqrt((a + c +- disc) / 2).
+inline double singular_disc(const StretchTerms& t) {
+  return std::sqrt(std::max((t.a - t.c) * (t.a - t.c) + 4.0 * t.b * t.b, 0.0));
+}
+
 }  // namespace spherekit::detail

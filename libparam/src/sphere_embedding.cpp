@@ -282,7 +282,7 @@ class Refiner {
   int next_threshold(int nv) const {
     // Extra optimization at coarse levels (ratio sqrt(r) up to 1000 vertices), as the
     // reference implementation does: coarse levels decide the global layout.
-    double r = nv <= 1000 ? std::sqrt(s_.nv_ratio) : s_.nv_ratio;
+    double r = nv <= kCoarseLevelVertices ? std::sqrt(s_.nv_ratio) : s_.nv_ratio;
     return std::max(nv + 1, static_cast<int>(std::lround(nv * r)));
   }
 
@@ -482,15 +482,19 @@ class Refiner {
   }
 
   Status optimize_level(const OptimizerSettings& level_settings) {
-    // Above the coarse layout's levels (precise_vertices) only faces wider than about 18
-    // degrees take the accordion split (fine_split_distance). There the layout is set and
-    // the faces the 0.99 test still splits are mostly small obtuse ones, whose split energy
-    // equals their chord energy to second order in their size, at ten times the cost of
-    // its central differences: on the generated tentacle shape the split faces were half of
-    // the CPU time (issue 20: tentacles_r96-holes 14.1 -> 9.6 s, efficiency 0.1862 ->
-    // 0.1848 against the reference implementation's 0.1566).
+    // Above the coarse levels (fine_split_vertices: kCoarseLevelVertices) only faces wider
+    // than about 18 degrees take the accordion split (fine_split_distance). There the layout
+    // is set and the faces the 0.99 test still splits are mostly small obtuse ones, whose
+    // split energy equals their chord energy to second order in their size, at ten times the
+    // cost of its central differences: on the generated tentacle shape the split faces were
+    // half of the CPU time (issue 20: tentacles_r96-holes 14.1 -> 9.6 s, efficiency 0.1862 ->
+    // 0.1848 against the reference implementation's 0.1566, with the boundary at the precise
+    // layout's 3000 vertices). The boundary is now the coarse levels' own (session 45): on
+    // limb shapes of 4-5k vertices the levels from 1000 to 3000 were 60% of the time, at 2.5x
+    // the cost per vertex of the levels above (CPU -10 to -25%, tentacles_r48-holes 5.5 ->
+    // 4.2 s; efficiency within -0.006..+0.001 on 73 meshes, all still above the reference).
     OptimizerSettings s = level_settings;
-    if (s.fine_split_distance > 0 && s.precise_vertices > 0 && st_.alive_vertices > s.precise_vertices)
+    if (s.fine_split_distance > 0 && st_.alive_vertices > s.fine_split_vertices)
       s.split_distance = s.fine_split_distance;
     update_hole_faces();
     // The levels weight each face by its area plus a share of the mean face area

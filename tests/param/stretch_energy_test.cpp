@@ -15,6 +15,7 @@
 #include "detail/worker_pool.h"
 #include "spherekit/metrics.h"
 #include "spherekit/predicates.h"
+#include "spherekit/progressive_mesh.h"
 #include "spherekit/sphere_param.h"
 #include "test_meshes.h"
 
@@ -631,4 +632,53 @@ TEST_CASE("the outlier polish lowers a planted outlier's stretch and keeps the m
   for (int v = 0; v < static_cast<int>(with.rows()); ++v) moved += with.row(v) != without.row(v) ? 1 : 0;
   CHECK(moved >= 1);
   CHECK(moved <= 4);
+}
+
+TEST_CASE("the coarse levels' accordion split ends at the coarse levels' boundary", "[param][sphere][energy]") {
+  // OptimizerSettings::fine_split_vertices: levels above kCoarseLevelVertices take the
+  // cheaper split test (faces wider than about 18 degrees); below it every face wider than
+  // about 8 degrees is split. A six-armed star of 2562 vertices has levels on both sides of
+  // the boundary, and below the precise layout's 3000 vertices, where it was before.
+  TriMesh star = test::icosphere(4);
+  for (Eigen::Index v = 0; v < star.V.rows(); ++v) {
+    const Eigen::RowVector3d n = star.V.row(v).normalized();
+    const double arm = n.cwiseAbs().maxCoeff();
+    star.V.row(v) = n * (1.0 + 4.0 * std::pow(std::max(0.0, (arm - 0.8) / 0.2), 2.0));
+  }
+  const SphereParamOptions o;
+  OptimizerSettings s = optimizer_settings(o);
+  REQUIRE(s.fine_split_vertices == kCoarseLevelVertices);
+  REQUIRE(s.precise_vertices > static_cast<int>(star.V.rows()));
+  CHECK(optimizer_settings(collection_sphere_options()).fine_split_distance == 0.0);  // collections: 0.99 everywhere
+  s.threads = 1;
+  ProgressiveMeshOptions pmo;
+  pmo.normal_weight = 0.02;
+  pmo.memoryless = true;
+  const RowMatXd P = star.V / (star.V.colwise().maxCoeff() - star.V.colwise().minCoeff()).norm();
+  auto pm = build_progressive_mesh(P, star.F, pmo);
+  REQUIRE(pm.ok());
+  EmbedInput in;
+  in.P = &P;
+  in.pm = &*pm;
+  auto embed = [&](int boundary, RowMat3d* S) {
+    OptimizerSettings t = s;
+    t.fine_split_vertices = boundary;
+    EmbedStats stats;
+    REQUIRE(embed_coarse_to_fine(in, t, {}, S, &stats).ok());
+  };
+  RowMat3d at_coarse, at_precise, split_everywhere;
+  embed(kCoarseLevelVertices, &at_coarse);
+  embed(s.precise_vertices, &at_precise);  // the boundary before (session 45)
+  embed(static_cast<int>(star.V.rows()), &split_everywhere);
+  CHECK(at_coarse != at_precise);  // the levels from 1000 to 2562 vertices were evaluated differently
+  CHECK(at_precise == split_everywhere);  // the boundary above the mesh: no level takes the cheaper test
+  auto mc = evaluate_sphere_map(star, at_coarse), mp = evaluate_sphere_map(star, at_precise);
+  REQUIRE(mc.ok());
+  REQUIRE(mp.ok());
+  INFO("efficiency " << mc->efficiency << " (boundary " << kCoarseLevelVertices << ") against " << mp->efficiency
+                     << " (" << s.precise_vertices << "), Linf " << mc->linf << " against " << mp->linf);
+  CHECK(count_flipped_faces(star.F, at_coarse) == 0);
+  CHECK(mc->winding == Approx(1.0));
+  CHECK(mc->efficiency > mp->efficiency - 0.005);  // the layout is set below 1000 vertices
+  CHECK(mc->linf < 1.5 * mp->linf);
 }

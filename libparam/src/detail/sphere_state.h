@@ -50,6 +50,12 @@ struct SphereState {
 
 /// Per-effort settings of the optimizer (Praun & Hoppe 2003's schedule; the numbers are
 /// the reference implementation's presets, REFERENCE.md §2.5).
+/// The coarse levels of the coarse-to-fine refinement: up to this many vertices a level is
+/// optimized each time #V grows by sqrt(nv_ratio) instead of nv_ratio (as the reference
+/// implementation does), and large faces there take the accordion split from about 8 degrees
+/// (split_distance) instead of fine_split_distance. These levels decide the global layout.
+inline constexpr int kCoarseLevelVertices = 1000;
+
 struct OptimizerSettings {
   int line_search_iter = 10;   ///< energy evaluations per 1-D search
   int vsplit_vt_iter = 2;      ///< local optimizations of each inserted vertex
@@ -68,9 +74,11 @@ struct OptimizerSettings {
   int precise_vertices = 0;
   double precise_movetol_rel = 0;
   int precise_rounds = 0;
-  /// If > 0: the split_distance of the level passes above precise_vertices vertices (the
-  /// final pass keeps its own). SphereParamOptions::precise_layout sets 0.95.
+  /// If > 0: the split_distance of the level passes above fine_split_vertices vertices (the
+  /// final pass keeps its own). SphereParamOptions::precise_layout sets 0.95 above
+  /// kCoarseLevelVertices.
   double fine_split_distance = 0;
+  int fine_split_vertices = 0;
   /// Every face's energy weight is its surface area plus this fraction of the mean face area
   /// (SphereState::area_floor_rel). SphereParamOptions::precise_layout sets 0.03 for the
   /// coarse-to-fine levels; the final pass takes the default, the measured objective.

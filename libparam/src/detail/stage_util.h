@@ -27,6 +27,7 @@ inline OptimizerSettings optimizer_settings(const SphereParamOptions& o) {
     s.precise_rounds = 10;
     s.final_iter = std::max(s.final_iter, 3);
     s.fine_split_distance = 0.95;
+    s.fine_split_vertices = kCoarseLevelVertices;
     s.area_floor_rel = 0.03;
     s.pass_work_cap = 64;
   }

@@ -261,10 +261,28 @@ TEST_CASE("progressive mesh in blocks: valid, the same for any thread count, the
          plain->collapses[same_prefix].vs == runs[0].collapses[same_prefix].vs)
     ++same_prefix;
   CHECK(same_prefix < runs[0].collapses.size() / 4);
-  // A mesh of fewer than two blocks' vertices is simplified as one.
-  opt.block_vertices = static_cast<int>(m.V.rows()) / 2 + 1;
+  // A mesh of fewer than 1.5 blocks' vertices is simplified as one.
+  opt.block_vertices = static_cast<int>(m.V.rows()) * 2 / 3 + 1;
   auto one = build_progressive_mesh(m.V, m.F, opt);
   REQUIRE(one.ok());
   REQUIRE(one->collapses.size() == plain->collapses.size());
   for (size_t i = 0; i < plain->collapses.size(); ++i) CHECK(one->collapses[i].vt == plain->collapses[i].vt);
+  // From 1.5 blocks' vertices up it is cut in two (igea decimated to 13k vertices with blocks
+  // of 8192), valid and the same for any thread count.
+  opt.block_vertices = static_cast<int>(m.V.rows()) * 2 / 3;
+  std::vector<ProgressiveMesh> halves;
+  for (int threads : {1, 2}) {
+    opt.threads = threads;
+    auto pm = build_progressive_mesh(m.V, m.F, opt);
+    REQUIRE(pm.ok());
+    check_replays_exactly(*pm, m);
+    halves.push_back(std::move(*pm));
+  }
+  REQUIRE(halves[0].collapses.size() == plain->collapses.size());
+  bool differs = false;
+  for (size_t i = 0; i < plain->collapses.size(); ++i) {
+    differs = differs || halves[0].collapses[i].vt != plain->collapses[i].vt;
+    CHECK(halves[0].collapses[i].vt == halves[1].collapses[i].vt);
+  }
+  CHECK(differs);
 }

@@ -269,7 +269,7 @@ void add_sphere_param_options(CLI::App& command, SphereParamOptions& o) {
                      "weight of the shape term that keeps hole faces from becoming slivers (shape-defining)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   command.add_option("--block-vertices", o.block_vertices,
-                     "simplify meshes of 2x this many vertices in blocks of this many first, in parallel; 0: one greedy (shape-defining)")
+                     "simplify meshes of 1.5x this many vertices in blocks of about this many first, in parallel; 0: one greedy (shape-defining)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   add_hidden_alias(command, "--regularizer_weight", o.regularizer_weight);
   add_hidden_alias(command, "--hole_weight", o.hole_weight);

@@ -80,8 +80,8 @@ struct ProgressiveMeshOptions {
   /// parameterization's simplification stays as it was.
   bool degenerate_faces_free = false;
   /// Parallel fine levels (memoryless quadrics, no constraint edges or kept vertices): with
-  /// block_vertices > 0 and a mesh of at least 2 x that many vertices, the mesh is first cut
-  /// into spatial blocks of about this many vertices; each block is simplified on its own
+  /// block_vertices > 0 and a mesh of at least 1.5 x that many vertices, the mesh is first
+  /// cut into spatial blocks of about this many vertices (two below 2 x); each block is simplified on its own
   /// (blocks in parallel) by the same greedy, its vertices next to another block held, and
   /// one cost cut for all blocks keeps (1 - block_fraction) of their other vertices'
   /// collapses in all; rounds repeat while two blocks remain, then the greedy goes on over

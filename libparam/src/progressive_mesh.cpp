@@ -261,7 +261,8 @@ class Simplifier {
     // A mesh of 1.5 to 2 blocks' vertices is cut in two for its first round (igea decimated
     // to 13k vertices: its serial simplification was 11% of the one-thread time, 2-thread /
     // 1-thread wall 0.65); later rounds, and meshes of two blocks or more, as before.
-    for (bool first = true; alive_count_ >= 2 * size || (first && 2 * static_cast<long long>(alive_count_) >= 3LL * size);
+    for (bool first = true;
+         alive_count_ >= 2 * size || (first && 2 * static_cast<long long>(alive_count_) >= 3LL * size);
          first = false) {
       const int blocks = std::max(2, alive_count_ / size);
       std::vector<std::vector<int>> members(static_cast<size_t>(blocks)), faces(static_cast<size_t>(blocks));

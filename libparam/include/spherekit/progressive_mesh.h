@@ -81,12 +81,12 @@ struct ProgressiveMeshOptions {
   bool degenerate_faces_free = false;
   /// Parallel fine levels (memoryless quadrics, no constraint edges or kept vertices): with
   /// block_vertices > 0 and a mesh of at least 1.5 x that many vertices, the mesh is first
-  /// cut into spatial blocks of about this many vertices (two below 2 x); each block is simplified on its own
-  /// (blocks in parallel) by the same greedy, its vertices next to another block held, and
-  /// one cost cut for all blocks keeps (1 - block_fraction) of their other vertices'
-  /// collapses in all; rounds repeat while two blocks remain, then the greedy goes on over
-  /// the whole mesh. The blocks depend on the mesh only, so the result does not depend on
-  /// `threads`.
+  /// cut into spatial blocks of about this many vertices (two below 2 x); each block is
+  /// simplified on its own (blocks in parallel) by the same greedy, its vertices next to
+  /// another block held, and one cost cut for all blocks keeps (1 - block_fraction) of their
+  /// other vertices' collapses in all; rounds repeat while two blocks remain, then the greedy
+  /// goes on over the whole mesh. The blocks depend on the mesh only, so the result does not
+  /// depend on `threads`.
   /// 0 (default): one greedy over the whole mesh.
   int block_vertices = 0;
   double block_fraction = 0.2;

@@ -65,8 +65,8 @@ struct SphereParamOptions {
   bool precise_layout = true;
   /// The progressive mesh's fine levels in parallel (ProgressiveMeshOptions::block_vertices):
   /// a mesh of at least 1.5 times this many vertices is first simplified in spatial blocks of
-  /// about this many (two below twice this many), each by the same greedy on its own, its vertices next to another block
-  /// held, until a fifth of their vertices remain in all (one cost cut for all blocks), in
+  /// about this many (two below twice this many), each by the same greedy on its own, its
+  /// vertices next to another block held, until a fifth of their vertices remain in all (one cost cut for all blocks), in
   /// rounds while two blocks remain; then as one. The blocks depend on the mesh only
   /// (results do not depend on `threads`). The serial greedy
   /// was a quarter of igea's time with one thread and a third with two (issue 20); blocks

@@ -48,14 +48,14 @@ struct SphereState {
   void update_hole_area_penalty();
 };
 
-/// Per-effort settings of the optimizer (Praun & Hoppe 2003's schedule; the numbers are
-/// the reference implementation's presets, REFERENCE.md §2.5).
 /// The coarse levels of the coarse-to-fine refinement: up to this many vertices a level is
 /// optimized each time #V grows by sqrt(nv_ratio) instead of nv_ratio (as the reference
 /// implementation does), and large faces there take the accordion split from about 8 degrees
 /// (split_distance) instead of fine_split_distance. These levels decide the global layout.
 inline constexpr int kCoarseLevelVertices = 1000;
 
+/// Per-effort settings of the optimizer (Praun & Hoppe 2003's schedule; the numbers are
+/// the reference implementation's presets, REFERENCE.md §2.5).
 struct OptimizerSettings {
   int line_search_iter = 10;   ///< energy evaluations per 1-D search
   int vsplit_vt_iter = 2;      ///< local optimizations of each inserted vertex

@@ -1,5 +1,6 @@
 #include "test_meshes.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -166,6 +167,16 @@ TriMesh random_blob(int level, std::uint64_t seed) {
 TriMesh elongated(int level, double aspect) {
   TriMesh m = icosphere(level);
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) m.V(i, 0) *= aspect;
+  return m;
+}
+
+TriMesh six_armed_star(int level) {
+  TriMesh m = icosphere(level);
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
+    const Eigen::RowVector3d n = m.V.row(v).normalized();
+    const double arm = n.cwiseAbs().maxCoeff();  // 1 on an axis, 1/sqrt(3) between
+    m.V.row(v) = n * (1.0 + 4.0 * std::pow(std::max(0.0, (arm - 0.8) / 0.2), 2.0));
+  }
   return m;
 }
 

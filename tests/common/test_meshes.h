@@ -28,6 +28,10 @@ TriMesh sphere_with_holes(int level, int holes);
 TriMesh random_blob(int level, std::uint64_t seed);
 /// A long thin shape (capsule stretched `aspect` times along x): hard for stretch.
 TriMesh elongated(int level, double aspect);
+/// A six-armed star: an icosphere pushed out to radius 5 along the +-x, +-y, +-z axes (arms
+/// where the largest coordinate of the unit direction exceeds 0.8), a limb shape whose arms
+/// the stretch optimum squeezes on the sphere.
+TriMesh six_armed_star(int level);
 
 /// A mesh with polygon faces, as a DCC tool exports it.
 struct PolygonMesh {

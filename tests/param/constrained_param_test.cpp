@@ -560,12 +560,7 @@ TEST_CASE("a map keeping too little of its unconstrained efficiency is made agai
   // features on the arm tips and two body points, mapped to its own unconstrained map's
   // feature images: targets the unconstrained optimum meets exactly, so a constrained map
   // losing efficiency here loses it to its settings, not to the constraints.
-  TriMesh m = test::icosphere(4);
-  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
-    const Eigen::RowVector3d n = m.V.row(v).normalized();
-    const double arm = n.cwiseAbs().maxCoeff();
-    m.V.row(v) = n * (1.0 + 4.0 * std::pow(std::max(0.0, (arm - 0.8) / 0.2), 2.0));
-  }
+  TriMesh m = test::six_armed_star(4);
   const std::vector<int> fv = pick_features(m, {{1, 0, 0},
                                                 {-1, 0, 0},
                                                 {0, 1, 0},

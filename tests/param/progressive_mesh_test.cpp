@@ -239,16 +239,22 @@ TEST_CASE("progressive mesh in blocks: valid, the same for any thread count, the
   opt.normal_weight = 0.02;
   auto plain = build_progressive_mesh(m.V, m.F, opt);
   REQUIRE(plain.ok());
-  opt.block_vertices = 300;
-  std::vector<ProgressiveMesh> runs;
-  for (int threads : {1, 3}) {
-    opt.threads = threads;
-    auto pm = build_progressive_mesh(m.V, m.F, opt);
-    REQUIRE(pm.ok());
-    check_replays_exactly(*pm, m);
-    CHECK(pm->forced_collapses == 0);
-    runs.push_back(std::move(*pm));
-  }
+  // The progressive mesh with blocks of `block_vertices`, for each thread count, each checked
+  // to replay exactly.
+  auto blocked = [&](int block_vertices, std::initializer_list<int> thread_counts) {
+    opt.block_vertices = block_vertices;
+    std::vector<ProgressiveMesh> pms;
+    for (int threads : thread_counts) {
+      opt.threads = threads;
+      auto pm = build_progressive_mesh(m.V, m.F, opt);
+      REQUIRE(pm.ok());
+      check_replays_exactly(*pm, m);
+      pms.push_back(std::move(*pm));
+    }
+    return pms;
+  };
+  std::vector<ProgressiveMesh> runs = blocked(300, {1, 3});
+  for (const auto& pm : runs) CHECK(pm.forced_collapses == 0);
   REQUIRE(runs[0].collapses.size() == runs[1].collapses.size());
   for (size_t i = 0; i < runs[0].collapses.size(); ++i) {
     CHECK(runs[0].collapses[i].vt == runs[1].collapses[i].vt);
@@ -269,15 +275,7 @@ TEST_CASE("progressive mesh in blocks: valid, the same for any thread count, the
   for (size_t i = 0; i < plain->collapses.size(); ++i) CHECK(one->collapses[i].vt == plain->collapses[i].vt);
   // From 1.5 blocks' vertices up it is cut in two (igea decimated to 13k vertices with blocks
   // of 8192), valid and the same for any thread count.
-  opt.block_vertices = static_cast<int>(m.V.rows()) * 2 / 3;
-  std::vector<ProgressiveMesh> halves;
-  for (int threads : {1, 2}) {
-    opt.threads = threads;
-    auto pm = build_progressive_mesh(m.V, m.F, opt);
-    REQUIRE(pm.ok());
-    check_replays_exactly(*pm, m);
-    halves.push_back(std::move(*pm));
-  }
+  const std::vector<ProgressiveMesh> halves = blocked(static_cast<int>(m.V.rows()) * 2 / 3, {1, 2});
   REQUIRE(halves[0].collapses.size() == plain->collapses.size());
   bool differs = false;
   for (size_t i = 0; i < plain->collapses.size(); ++i) {

@@ -154,12 +154,7 @@ TEST_CASE("the unconstrained map's anti-cruft weight lets limbs reach a lower st
   // the body is wide. Its stretch optimum gives the body more sphere than its surface (the
   // arms are squeezed), where the anti-cruft term w * min(a',c')^-3 binds: at the reference's
   // weight (the collection stages' 1e-4) it holds the map above its measured optimum.
-  TriMesh m = test::icosphere(3);
-  for (Eigen::Index v = 0; v < m.V.rows(); ++v) {
-    const Eigen::RowVector3d n = m.V.row(v).normalized();
-    const double arm = n.cwiseAbs().maxCoeff();  // 1 on an axis, 1/sqrt(3) between
-    m.V.row(v) = n * (1.0 + 4.0 * std::pow(std::max(0.0, (arm - 0.8) / 0.2), 2.0));
-  }
+  TriMesh m = test::six_armed_star(3);
   SphereParamOptions o;
   o.threads = 1;
   auto ours = parameterize_sphere(m, o);
@@ -184,13 +179,7 @@ TEST_CASE("coarse levels converged more tightly give a better layout at a bounde
   // levels only move vertices locally. Smooth shapes (random blobs at 2562 vertices: every level
   // is "coarse" except the final pass) and a limb shape (the six-armed star of the test above).
   std::vector<TriMesh> shapes = {test::random_blob(4, 11), test::random_blob(4, 12), test::elongated(4, 4.0)};
-  TriMesh star = test::icosphere(3);
-  for (Eigen::Index v = 0; v < star.V.rows(); ++v) {
-    const Eigen::RowVector3d n = star.V.row(v).normalized();
-    const double arm = n.cwiseAbs().maxCoeff();
-    star.V.row(v) = n * (1.0 + 4.0 * std::pow(std::max(0.0, (arm - 0.8) / 0.2), 2.0));
-  }
-  shapes.push_back(star);
+  shapes.push_back(test::six_armed_star(3));
   double gain = 0;
   for (size_t i = 0; i < shapes.size(); ++i) {
     SphereParamOptions o;

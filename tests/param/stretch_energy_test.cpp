@@ -639,12 +639,7 @@ TEST_CASE("the coarse levels' accordion split ends at the coarse levels' boundar
   // cheaper split test (faces wider than about 18 degrees); below it every face wider than
   // about 8 degrees is split. A six-armed star of 2562 vertices has levels on both sides of
   // the boundary, and below the precise layout's 3000 vertices, where it was before.
-  TriMesh star = test::icosphere(4);
-  for (Eigen::Index v = 0; v < star.V.rows(); ++v) {
-    const Eigen::RowVector3d n = star.V.row(v).normalized();
-    const double arm = n.cwiseAbs().maxCoeff();
-    star.V.row(v) = n * (1.0 + 4.0 * std::pow(std::max(0.0, (arm - 0.8) / 0.2), 2.0));
-  }
+  const TriMesh star = test::six_armed_star(4);
   const SphereParamOptions o;
   OptimizerSettings s = optimizer_settings(o);
   REQUIRE(s.fine_split_vertices == kCoarseLevelVertices);

@@ -35,11 +35,6 @@ namespace {
 
 constexpr double kFourPi = 4.0 * M_PI;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// Per face and model in RingScratch::surf: pv (3), pa (3), pb (3), face weight / model area,
-// area floor, then the surface edge Gram entries |d1|^2, |d2|^2, d1.d2 (d1 = pa - pv,
-// d2 = pb - pv) and the surface area: constant while v moves, so the common case needs no
-// surface arithmetic at all; last the shape-term weight (see load_ring).
-constexpr size_t kSurfStride = 16;
 
 // SplitMix64: a stateless hash, so the random direction of a vertex depends only on
 // (seed, pass, round, vertex) and never on thread scheduling.
@@ -111,14 +106,19 @@ double brent_minimize(Fn&& f, double lo, double hi, double x0, double f0, int ma
 // allows t in (phi - pi/2, phi + pi/2); n.x0 > 0 at t = 0 puts phi in (-pi/2, pi/2).
 bool feasible_interval(const RingScratch& ring, const Eigen::Vector3d& x0, const Eigen::Vector3d& d,
                        double* lo, double* hi) {
-  double l = -M_PI / 2, h = M_PI / 2;
+  // Face k allows the angles (phi_k - pi/2, phi_k + pi/2), phi_k = atan2(beta_k, alpha_k) with
+  // alpha_k > 0, monotone in beta_k / alpha_k: the interval's ends come from the largest and
+  // the smallest ratio (compared by cross-multiplication), with two arc tangents per call
+  // instead of one per face.
+  double amax = 1, bmax = -kInf, amin = 1, bmin = kInf;  // (alpha, beta) of the extreme ratios
   for (const auto& rf : ring.faces) {
-    double alpha = rf.n.dot(x0), beta = rf.n.dot(d);
+    const double alpha = rf.n.dot(x0), beta = rf.n.dot(d);
     if (!(alpha > 0)) return false;  // current position not strictly inside (rounding)
-    double phi = std::atan2(beta, alpha);
-    l = std::max(l, phi - M_PI / 2);
-    h = std::min(h, phi + M_PI / 2);
+    if (beta * amax > bmax * alpha) amax = alpha, bmax = beta;
+    if (beta * amin < bmin * alpha) amin = alpha, bmin = beta;
   }
+  const double l = std::max(-M_PI / 2, std::atan2(bmax, amax) - M_PI / 2);
+  const double h = std::min(M_PI / 2, std::atan2(bmin, amin) + M_PI / 2);
   if (!(h > 0 && l < 0)) return false;
   // Pad inward by 1% at each end so no triangle can fully collapse (Praun & Hoppe's margin).
   double pad = 0.01 * (h - l);
@@ -271,23 +271,20 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring, const RingIndex*
     rf.real = st.face_shape_weight.empty() || !(st.face_shape_weight[static_cast<size_t>(f)] > 0);
     for (int m = 0; m < st.models; ++m) {
       double* s = &ring.surf[(i * static_cast<size_t>(st.models) + static_cast<size_t>(m)) * kSurfStride];
-      for (int d = 0; d < 3; ++d) {
-        s[d] = P(v, 3 * m + d);
-        s[3 + d] = P(rf.a, 3 * m + d);
-        s[6 + d] = P(rf.b, 3 * m + d);
-      }
-      s[9] = st.face_weight[static_cast<size_t>(f)] / st.model_area[static_cast<size_t>(m)];
-      s[10] = st.area_floor[static_cast<size_t>(m)];
-      Eigen::Vector3d d1(s[3] - s[0], s[4] - s[1], s[5] - s[2]), d2(s[6] - s[0], s[7] - s[1], s[8] - s[2]);
-      s[11] = d1.squaredNorm();
-      s[12] = d2.squaredNorm();
-      s[13] = d1.dot(d2);
-      s[14] = 0.5 * d1.cross(d2).norm();
+      const Eigen::Vector3d pv = P.row(v).segment<3>(3 * m).transpose();
+      const Eigen::Vector3d d1 = P.row(rf.a).segment<3>(3 * m).transpose() - pv;
+      const Eigen::Vector3d d2 = P.row(rf.b).segment<3>(3 * m).transpose() - pv;
+      s[kSurfWeight] = st.face_weight[static_cast<size_t>(f)] / st.model_area[static_cast<size_t>(m)];
+      s[kSurfFloor] = st.area_floor[static_cast<size_t>(m)];
+      s[kSurfG11] = d1.squaredNorm();
+      s[kSurfG22] = d2.squaredNorm();
+      s[kSurfG12] = d1.dot(d2);
+      s[kSurfArea] = 0.5 * d1.cross(d2).norm();
       // The shape term has the weight of an average face of the level, whatever the hole
       // face's own area: a hole's filling can be as large as the model (a flat shape's
       // back) or tiny, and its pull must not depend on that. MIPS is scale-free, so the
       // hole may still shrink freely on the sphere.
-      s[15] = st.face_shape_weight.empty()
+      s[kSurfShape] = st.face_shape_weight.empty()
                   ? 0.0
                   : st.face_shape_weight[static_cast<size_t>(f)] * st.average_face_area[static_cast<size_t>(m)] /
                         st.model_area[static_cast<size_t>(m)];
@@ -311,14 +308,14 @@ namespace {
 // with the reference at one thread: generated limb shapes standing 0.3359 -> 0.3454 and
 // quadruped 0.3153 -> 0.3243, the reference 0.3352 and 0.3176; armadillo 0.4170 -> 0.4235,
 // horse 0.3934 -> 0.4005, the reference 0.4127 and 0.3928).
+// The three reciprocals come from one division (1/m1 = m2 m3 / (m1 m2 m3)): this term is
+// evaluated for every face at every trial point, and divisions dominate its cost.
 inline double cruft_term(double T, double a1, double a2, double a3, double reg_weight) {
-  double sum = 0;
-  for (double a : {a1, a2, a3}) {
-    const double m = std::min(a, T - a);
-    if (!(m > 0)) return kInf;
-    sum += 1 / (m * m * m);
-  }
-  return reg_weight * sum / 3;
+  const double m1 = std::min(a1, T - a1), m2 = std::min(a2, T - a2), m3 = std::min(a3, T - a3);
+  if (!(m1 > 0 && m2 > 0 && m3 > 0)) return kInf;
+  const double inv = 1 / (m1 * m2 * m3);
+  const double r1 = m2 * m3 * inv, r2 = m1 * m3 * inv, r3 = m1 * m2 * inv;
+  return reg_weight * (r1 * r1 * r1 + r2 * r2 * r2 + r3 * r3 * r3) / 3;
 }
 
 // The anti-cruft term as the collection stages use it: w * g^-3, g the smallest squared
@@ -335,31 +332,38 @@ inline double singular_cruft_term(double T, double D, double reg_weight) {
   return g > 0 ? reg_weight / (g * g * g) : kInf;
 }
 
-// Energy of one chord (sub)triangle q0,q1,q2 -> surface p0,p1,p2, formed explicitly.
-inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
-                           const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
-                           double scale, double floor, double reg_weight, double weight, double shape_weight,
-                           bool edge_frames) {
-  Eigen::Vector3d e1 = q1 - q0, e2 = q2 - q0;
-  double l1sq = e1.squaredNorm();
-  if (!(l1sq > 0)) return kInf;
-  double l1 = std::sqrt(l1sq);
-  double e2u = e2.dot(e1) / l1;
-  double hsq = e2.squaredNorm() - e2u * e2u;
-  if (!(hsq > 1e-24 * l1sq)) return kInf;  // chord triangle (numerically) collapsed
-  double h = std::sqrt(hsq);
-  Eigen::Vector3d d1 = p1 - p0, d2 = p2 - p0;
-  Eigen::Vector3d Ss = d1 / l1;
-  Eigen::Vector3d St = (d2 - e2u * Ss) / h;
-  double a = Ss.squaredNorm() * scale, c = St.squaredNorm() * scale, b = Ss.dot(St) * scale;
-  double T = a + c, D = a * c - b * b;
-  const Eigen::Vector3d e3 = e2 - e1, d3 = d2 - d1;
-  double reg = edge_frames ? cruft_term(T, a, scale * d2.squaredNorm() / e2.squaredNorm(),
-                                        scale * d3.squaredNorm() / e3.squaredNorm(), reg_weight)
-                           : singular_cruft_term(T, D, reg_weight);
-  double area = 0.5 * d1.cross(d2).norm();
-  double e = weight * (area + floor) * (0.5 * (a + c) + reg);
-  if (shape_weight != 0) e += D > 0 ? 0.5 * shape_weight * (0.5 * T / std::sqrt(D)) : kInf;
+// Energy of one triangle from the Gram entries of its edges, without forming the Jacobian:
+// domain edges e1, e2, e3 = e2 - e1 (E11, E22, E12, E33) and surface edges d1, d2, d3
+// (D11, D22, D12, D33), surface area `area`. For the affine map,
+//   a + c = |J|_F^2 = (|e2|^2 |d1|^2 + |e1|^2 |d2|^2 - 2 (e1.e2)(d1.d2)) / (4 A_dom^2),
+// and along edge k the squared stretch is |d_k|^2 / |e_k|^2 (the anti-cruft term's frames).
+// The third edges are passed in rather than formed as E11 + E22 - 2 E12: the split halves
+// below have them exactly (no cancellation on their slivers).
+inline double gram_face_energy(double E11, double E22, double E12, double E33, double D11, double D22, double D12,
+                               double D33, double area, double floor, double weight, double shape_weight,
+                               double scale, double reg_weight, bool edge_frames) {
+  const double four_a2 = E11 * E22 - E12 * E12;  // (2 A_dom)^2
+  if (!(four_a2 > 1e-24 * E11 * E22)) return kInf;
+  // 1 / four_a2 and 1 / (E11 E22 E33) from one division (this is evaluated for every face at
+  // every trial point, and its divisions dominate its cost).
+  const double E123 = E11 * E22 * E33;
+  const double inv = scale / (four_a2 * E123);
+  const double T = gram_frobenius_numerator(E11, E22, E12, D11, D22, D12) * (E123 * inv);
+  double reg;
+  if (edge_frames) {
+    const double iE = four_a2 * inv;  // scale / (E11 E22 E33)
+    reg = cruft_term(T, D11 * (E22 * E33 * iE), D22 * (E11 * E33 * iE), D33 * (E11 * E22 * iE), reg_weight);
+  } else {
+    reg = singular_cruft_term(T, 4 * area * area * (scale * scale / four_a2), reg_weight);
+  }
+  if (!std::isfinite(reg)) return kInf;
+  double e = weight * (area + floor) * (0.5 * T + reg);
+  // Scale-free shape term (MIPS, (s1^2 + s2^2) / (2 s1 s2) = T / (2 sqrt D), >= 1), D =
+  // det(J^T J) = (A_surf / A_dom)^2.
+  if (shape_weight != 0) {
+    const double D = 4 * area * area * (scale * scale / four_a2);
+    e += D > 0 ? shape_weight * (0.5 * T / std::sqrt(D)) : kInf;
+  }
   return e;
 }
 
@@ -371,8 +375,15 @@ inline double chord_energy(const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
 // halves collapse and the energy grows without bound, although its own chord triangle
 // would stay fat and cheap; for moderately large triangles it charges the bulge of the
 // spherical triangle over its chord, which steers the coarse levels to good layouts.
-inline double split_face_energy(const Eigen::Vector3d* q, const Eigen::Vector3d* p, double scale, double floor,
-                                double reg_weight, double weight, double shape_weight, bool edge_frames) {
+// q: the face's sphere points (corner 0 the moving vertex); s: its RingScratch::surf record.
+// The halves are evaluated from Gram entries: the surface point pm = t p_j + (1 - t) p_k
+// makes every surface entry a polynomial in t of the face's own (constant) Gram entries, and
+// the halves' surface areas are (1 - t) and t times the face's. So the split needs no surface
+// vector arithmetic and no square root but m's normalization (issue 20: the central
+// differences of split faces were a third of the CPU time on generated limb shapes, when
+// each half formed its Jacobian and its area explicitly).
+inline double split_face_energy(const Eigen::Vector3d* q, const double* s, double scale, double reg_weight,
+                                bool edge_frames) {
   double L0 = (q[1] - q[2]).squaredNorm(), L1 = (q[2] - q[0]).squaredNorm(), L2 = (q[0] - q[1]).squaredNorm();
   int i = L0 >= L1 ? (L0 >= L2 ? 0 : 2) : (L1 >= L2 ? 1 : 2);
   int j = (i + 1) % 3, k = (i + 2) % 3;
@@ -383,39 +394,47 @@ inline double split_face_energy(const Eigen::Vector3d* q, const Eigen::Vector3d*
   double mlen = m.norm();
   if (!(mlen > 0)) return kInf;
   m /= mlen;
-  Eigen::Vector3d A = q[k].cross(m), B = (q[j] - q[k]).cross(m);
-  double bb = B.squaredNorm();
-  if (!(bb > 0)) return kInf;
-  double t = -A.dot(B) / bb;
-  Eigen::Vector3d pm = t * p[j] + (1 - t) * p[k];
-  return chord_energy(q[i], q[j], m, p[i], p[j], pm, scale, 0.5 * floor, reg_weight, weight, shape_weight, edge_frames) +
-         chord_energy(q[i], m, q[k], p[i], pm, p[k], scale, 0.5 * floor, reg_weight, weight, shape_weight, edge_frames);
+  // t: the chord q_k + t (q_j - q_k) meets the ray through m. Both lie in the plane
+  // normal to n, so with w = m x n: (q_k + t (q_j - q_k)) . w = 0.
+  const Eigen::Vector3d w = m.cross(n);
+  const double den = (q[k] - q[j]).dot(w);
+  if (!(den != 0)) return kInf;
+  const double t = q[k].dot(w) / den, u = 1 - t;
+  // Surface Gram entries at corner i (dj = p_j - p_i, dk = p_k - p_i) from the record's at
+  // corner 0 (|p1 - p0|^2, |p2 - p0|^2, (p1 - p0).(p2 - p0)); G33 = |p2 - p1|^2.
+  const double G11 = s[kSurfG11], G22 = s[kSurfG22], G12 = s[kSurfG12], G33 = G11 + G22 - 2 * G12;
+  const double Gjj = i == 0 ? G11 : i == 1 ? G33 : G22;
+  const double Gkk = i == 0 ? G22 : i == 1 ? G11 : G33;
+  const double Gjk = i == 0 ? G12 : i == 1 ? G11 - G12 : G22 - G12;
+  const double Gjk_edge = i == 0 ? G33 : i == 1 ? G22 : G11;  // |p_k - p_j|^2
+  // Both halves are evaluated at their corner m, where their edges meet at nearly a right
+  // angle (m is q_i's foot on the great circle): at corner i a thin half's two edges are
+  // nearly parallel, and its Gram determinant loses the digits the central differences need.
+  // On the surface, with dm = pm - p_i = t dj + u dk: |dm|^2, p_j - pm = u (p_j - p_k),
+  // p_k - pm = t (p_k - p_j), and (p_i - pm).(p_j - p_k) = -(dm.dj - dm.dk).
+  const double Dmm = t * t * Gjj + 2 * t * u * Gjk + u * u * Gkk;
+  const double Dcross = t * (Gjj - Gjk) + u * (Gjk - Gkk);  // dm.(dj - dk)
+  const Eigen::Vector3d ei = q[i] - m, ej = q[j] - m, ek = q[k] - m;
+  const double Eii = ei.squaredNorm();
+  const double floor = 0.5 * s[kSurfFloor], shape = 0.5 * s[kSurfShape];
+  // Half (m, i, j): third edge q_j - q_i, on the surface dj.
+  const double e1 = gram_face_energy(Eii, ej.squaredNorm(), ei.dot(ej), (q[j] - q[i]).squaredNorm(), Dmm,
+                                     u * u * Gjk_edge, -u * Dcross, Gjj, std::abs(u) * s[kSurfArea], floor, s[kSurfWeight], shape,
+                                     scale, reg_weight, edge_frames);
+  // Half (m, k, i): third edge q_i - q_k, on the surface dk.
+  const double e2 = gram_face_energy(ek.squaredNorm(), Eii, ek.dot(ei), (q[k] - q[i]).squaredNorm(),
+                                     t * t * Gjk_edge, Dmm, t * Dcross, Gkk, std::abs(t) * s[kSurfArea], floor, s[kSurfWeight],
+                                     shape, scale, reg_weight, edge_frames);
+  return e1 + e2;
 }
 
-// Energy of a small face from its Gram entries, without forming the Jacobian: for the affine
-// map with domain edges e1, e2 (from x) and surface edges d1, d2,
-//   a + c = |J|_F^2 = (|e2|^2 |d1|^2 + |e1|^2 |d2|^2 - 2 (e1.e2)(d1.d2)) / (4 A_dom^2),
-// which needs only dot products of the edges.
+// Energy of a small face on its chord triangle: domain edges e1, e2 from the moving vertex,
+// surface entries from the record.
 inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, const double* s, double scale,
                           double reg_weight, bool edge_frames) {
   const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
-  const double four_a2 = E11 * E22 - E12 * E12;  // (2 A_dom)^2
-  if (!(four_a2 > 1e-24 * E11 * E22)) return kInf;
-  const double T = gram_frobenius_numerator(E11, E22, E12, s[11], s[12], s[13]) * (scale / four_a2);
-  // The anti-cruft term along the three edges: domain edges e1, e2, e2 - e1 and surface
-  // edges d1, d2, d2 - d1, from the Gram entries.
-  const double reg = edge_frames ? cruft_term(T, scale * s[11] / E11, scale * s[12] / E22,
-                                              scale * (s[11] + s[12] - 2 * s[13]) / (E11 + E22 - 2 * E12), reg_weight)
-                                 : singular_cruft_term(T, 4 * s[14] * s[14] * (scale * scale / four_a2), reg_weight);
-  if (!std::isfinite(reg)) return kInf;
-  double e = s[9] * (s[14] + s[10]) * (0.5 * T + reg);
-  // Scale-free shape term (MIPS, (s1^2 + s2^2) / (2 s1 s2) = T / (2 sqrt D), >= 1), D =
-  // det(J^T J) = (A_surf / A_dom)^2.
-  if (s[15] != 0) {
-    const double D = 4 * s[14] * s[14] * (scale * scale / four_a2);
-    e += D > 0 ? s[15] * (0.5 * T / std::sqrt(D)) : kInf;
-  }
-  return e;
+  return gram_face_energy(E11, E22, E12, E11 + E22 - 2 * E12, s[kSurfG11], s[kSurfG22], s[kSurfG12], s[kSurfG11] + s[kSurfG22] - 2 * s[kSurfG12], s[kSurfArea],
+                          s[kSurfFloor], s[kSurfWeight], s[kSurfShape], scale, reg_weight, edge_frames);
 }
 
 // A ring face with v at y: its domain edges from y and whether it takes the accordion split.
@@ -445,9 +464,7 @@ inline double placed_face_energy(const SphereState& st, const RingScratch::Face&
                                  const double* s, double scale, const Eigen::Vector3d& y, double reg_weight) {
   if (!fp.large) return gram_energy(fp.e1, fp.e2, s, scale, reg_weight, st.edge_frame_cruft);
   const Eigen::Vector3d q[3] = {y, rf.qa, rf.qb};
-  const Eigen::Vector3d p[3] = {Eigen::Vector3d(s[0], s[1], s[2]), Eigen::Vector3d(s[3], s[4], s[5]),
-                                Eigen::Vector3d(s[6], s[7], s[8])};
-  return split_face_energy(q, p, scale, s[10], reg_weight, s[9], s[15], st.edge_frame_cruft);
+  return split_face_energy(q, s, scale, reg_weight, st.edge_frame_cruft);
 }
 
 // One ring face's energy for one model with v at y, without the hole-area term.

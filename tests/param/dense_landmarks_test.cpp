@@ -157,56 +157,78 @@ TEST_CASE("fitted targets that fold the map: their samples are left out and the 
   test::require_valid_map(m, out);
 }
 
-TEST_CASE("feature warp: where a feature passes close by another, the relaxation lets the flow go on",
+TEST_CASE("feature warp: where a feature passes close by another, the flow stalls, relaxes, and never breaks the map",
           "[param][constrained][dense]") {
-  // A bumpy blob's unconstrained map with 28 features standing still, and feature A whose arc
-  // runs past still feature B at a tenth of an edge (a third stopped being tight enough when
-  // the unconstrained maps' final pass began to minimize the measured stretch, issue 20): the
-  // mesh between them is squeezed into slivers that flip however small the step. Without the
-  // relaxation the warp gives up; with it (one stretch pass, features held) it completes,
-  // bijective, every feature exact.
-  const TriMesh m = test::random_blob(3, 11);
-  SphereParamOptions uo = collection_sphere_options();  // as the collection stages make their maps
-  uo.effort = 0;
-  auto u = parameterize_sphere(m, uo);
-  REQUIRE(u.ok());
-  RowMat3d S = u->map.S;
-  std::vector<int> fv;
-  for (int v = 0; v < m.V.rows(); v += 23) fv.push_back(v);
-  double edge = 0;  // mean edge angle of a face of the map
-  for (int c = 0; c < 3; ++c) edge += angle(S.row(m.F(0, c)).transpose(), S.row(m.F(0, (c + 1) % 3)).transpose()) / 3;
-  const Eigen::Vector3d b = S.row(fv[1]).transpose();
-  const Eigen::Vector3d side = b.cross(Eigen::Vector3d(0.3, 0.5, 0.8)).normalized();
-  const Eigen::Vector3d along = b.cross(side).normalized();
-  auto at = [&](double x, double y) { return (b + x * edge * along + y * edge * side).normalized(); };
-  // A (feature 0) first goes to 3 edges before B (a smooth move), then has to pass it.
-  REQUIRE(detail::warp_features_to_targets(m.V, m.F, {fv[0], fv[1]}, {at(-3, 0.1), b}, {}, &S).ok());
-  std::vector<Eigen::Vector3d> t;
-  for (int v : fv) t.push_back(S.row(v).transpose());
-  t[0] = at(3, 0.1);
+  // Bumpy blobs' unconstrained maps with 28 features standing still, and feature A whose arc
+  // runs past still feature B at a tenth or a twentieth of an edge: the mesh between them is
+  // squeezed into slivers that flip however small the step. Whether one such configuration
+  // completes depends on the map to the last digit: this test used to hold one configuration
+  // where the plain warp gave up and the relaxation (stretch passes, features held) let it
+  // complete; a 1e-16 change of the stretch arithmetic (session 46) made the plain warp
+  // complete it, and on a sweep of 12 configurations the relaxation completed none of the
+  // 11 the plain warp gave up on (before that change likewise: 1 of 12). So what is asserted
+  // is what holds for every configuration: the sweep has configurations where the flow
+  // stalls, the relaxation is then called, and every warp either completes bijective with
+  // every feature exact or gives up (SolverFailed) leaving the map as it was.
+  int plain_done = 0, relaxed_done = 0, tried = 0;
+  for (std::uint64_t seed : {11, 12, 13, 14, 15, 16})
+    for (double offset : {0.1, 0.05}) {
+      const TriMesh m = test::random_blob(3, seed);
+      SphereParamOptions uo = collection_sphere_options();  // as the collection stages make their maps
+      uo.effort = 0;
+      auto u = parameterize_sphere(m, uo);
+      REQUIRE(u.ok());
+      RowMat3d S = u->map.S;
+      std::vector<int> fv;
+      for (int v = 0; v < m.V.rows(); v += 23) fv.push_back(v);
+      double edge = 0;  // mean edge angle of a face of the map
+      for (int c = 0; c < 3; ++c) edge += angle(S.row(m.F(0, c)).transpose(), S.row(m.F(0, (c + 1) % 3)).transpose()) / 3;
+      const Eigen::Vector3d b = S.row(fv[1]).transpose();
+      const Eigen::Vector3d side = b.cross(Eigen::Vector3d(0.3, 0.5, 0.8)).normalized();
+      const Eigen::Vector3d along = b.cross(side).normalized();
+      auto at = [&](double x, double y) { return (b + x * edge * along + y * edge * side).normalized(); };
+      // A (feature 0) first goes to 3 edges before B (a smooth move), then has to pass it.
+      if (!detail::warp_features_to_targets(m.V, m.F, {fv[0], fv[1]}, {at(-3, offset), b}, {}, &S).ok()) continue;
+      ++tried;
+      std::vector<Eigen::Vector3d> t;
+      for (int v : fv) t.push_back(S.row(v).transpose());
+      t[0] = at(3, offset);
+      auto check_result = [&](const Status& status, const RowMat3d& out) {
+        INFO("seed " << seed << " offset " << offset);
+        if (!status.ok()) {
+          CHECK(status.code() == ErrorCode::SolverFailed);
+          CHECK(out == S);
+          return false;
+        }
+        CHECK(count_flipped_faces(m.F, out) == 0);
+        for (size_t j = 0; j < fv.size(); ++j) CHECK(angle(out.row(fv[j]).transpose(), t[j]) < 1e-12);
+        test::require_valid_map(m, out);
+        return true;
+      };
+      RowMat3d plain = S;
+      plain_done += check_result(detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &plain), plain);
 
-  RowMat3d plain = S;
-  CHECK(detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &plain).code() == ErrorCode::SolverFailed);
-  CHECK(plain == S);
-
-  std::vector<char> fixed(static_cast<size_t>(m.V.rows()), 0);
-  for (int v : fv) fixed[static_cast<size_t>(v)] = 1;
-  const std::vector<double> w(static_cast<size_t>(m.F.rows()), 1.0), sw(static_cast<size_t>(m.F.rows()), 0.0);
-  detail::OptimizerSettings os = detail::optimizer_settings(uo);
-  os.final_iter = 1;
-  const RowMatXd P = m.V;
-  int calls = 0;
-  const detail::WarpRelaxFn relax = [&](RowMat3d* Sr) {
-    ++calls;
-    return detail::optimize_in_place(P, m.F, w, sw, fixed, os, {}, Sr);
-  };
-  detail::WarpStats st;
-  REQUIRE(detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &S, &st, relax).ok());
-  CHECK(st.relaxed > 0);
-  CHECK(st.relaxed == calls);
-  CHECK(count_flipped_faces(m.F, S) == 0);
-  for (size_t j = 0; j < fv.size(); ++j) CHECK(angle(S.row(fv[j]).transpose(), t[j]) < 1e-12);
-  test::require_valid_map(m, S);
+      std::vector<char> fixed(static_cast<size_t>(m.V.rows()), 0);
+      for (int v : fv) fixed[static_cast<size_t>(v)] = 1;
+      const std::vector<double> w(static_cast<size_t>(m.F.rows()), 1.0), sw(static_cast<size_t>(m.F.rows()), 0.0);
+      detail::OptimizerSettings os = detail::optimizer_settings(uo);
+      os.final_iter = 1;
+      const RowMatXd P = m.V;
+      int calls = 0;
+      const detail::WarpRelaxFn relax = [&](RowMat3d* Sr) {
+        ++calls;
+        return detail::optimize_in_place(P, m.F, w, sw, fixed, os, {}, Sr);
+      };
+      detail::WarpStats st;
+      RowMat3d relaxed = S;
+      const Status rs = detail::warp_features_to_targets(m.V, m.F, fv, t, {}, &relaxed, &st, relax);
+      relaxed_done += check_result(rs, relaxed);
+      CHECK(st.relaxed == calls);
+      if (!rs.ok()) CHECK(calls > 0);  // it gave up only after relaxing
+    }
+  INFO("configurations " << tried << ", completed without the relaxation " << plain_done << ", with it " << relaxed_done);
+  CHECK(tried >= 10);
+  CHECK(plain_done < tried);  // the sweep does stall the flow
 }
 
 TEST_CASE("spread subset: well-spread, deterministic, sorted", "[param][constrained][dense]") {

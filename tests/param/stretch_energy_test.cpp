@@ -461,6 +461,97 @@ TEST_CASE("a small face's accordion split measures its chord triangle's energy t
   CHECK(optimizer_settings(collection_sphere_options()).area_floor_rel == 1e-3);
 }
 
+namespace {
+
+// A face's energy as the optimizer defines it, computed here from an explicit Jacobian of the
+// chord triangle q -> surface triangle p: weight (area + floor) (|J|_F^2 / 2 + anti-cruft),
+// the anti-cruft term reg / 3 sum_k min(a_k, T - a_k)^-3 along the three domain edges (a_k
+// the squared stretch along edge k, T = |J|_F^2, both times scale).
+double explicit_chord_energy(const Eigen::Vector3d q[3], const Eigen::Vector3d p[3], double scale, double weight,
+                             double floor, double reg, bool edge_frames) {
+  const Eigen::Vector3d e1 = q[1] - q[0], e2 = q[2] - q[0];
+  const Eigen::Vector3d u = e1.normalized(), w = (e2 - e2.dot(u) * u).normalized();
+  Eigen::Matrix2d dom;
+  dom << e1.dot(u), e2.dot(u), e1.dot(w), e2.dot(w);
+  Eigen::Matrix<double, 3, 2> surf;
+  surf.col(0) = p[1] - p[0];
+  surf.col(1) = p[2] - p[0];
+  const Eigen::Matrix<double, 3, 2> J = surf * dom.inverse();
+  const double T = J.squaredNorm() * scale;
+  double cruft = 0;
+  const Eigen::Vector3d edges[3] = {e1, e2, e2 - e1};
+  for (const Eigen::Vector3d& e : edges) {
+    const Eigen::Vector2d d(e.dot(u), e.dot(w));
+    const double a = (J * d.normalized()).squaredNorm() * scale;
+    cruft += 1 / std::pow(std::min(a, T - a), 3);
+  }
+  const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+  if (!edge_frames) {  // the collection stages' form: reg / g^3, g the smallest squared singular value
+    Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>> svd(J);
+    const double g = svd.singularValues()(1) * svd.singularValues()(1) * scale;
+    return weight * (area + floor) * (0.5 * T + reg / (g * g * g));
+  }
+  return weight * (area + floor) * (0.5 * T + reg / 3 * cruft);
+}
+
+}  // namespace
+
+TEST_CASE("the accordion split's energy from Gram entries is the split formed with explicit Jacobians",
+          "[param][sphere][energy]") {
+  // The optimizer evaluates the two halves of a split face from the face's constant surface
+  // Gram entries (stretch_optimizer.cpp, split_face_energy); here every half is formed as
+  // Praun & Hoppe describe it: m the foot of the opposite corner on the longest edge's great
+  // circle, its surface point interpolated where the chord meets the ray through m.
+  RadialCapsule c = radial_capsule();
+  SphereState st = make_state(c.m, c.S0, c.P);
+  const double reg = 1e-4, split = 0.99;
+  const bool edge_frames = GENERATE(true, false);
+  st.edge_frame_cruft = edge_frames;
+  int split_faces = 0;
+  for (int v = 0; v < static_cast<int>(c.m.V.rows()); ++v) {
+    RingScratch ring;
+    REQUIRE(load_ring(st, v, ring));
+    const Eigen::Vector3d x = st.S.row(v).transpose();
+    double expected = 0;
+    for (int f : st.vf[static_cast<size_t>(v)]) {
+      Eigen::Vector3d q[3], p[3];
+      for (int k = 0; k < 3; ++k) {
+        q[k] = st.S.row(st.F[static_cast<size_t>(f)][k]).transpose();
+        p[k] = c.P.row(st.F[static_cast<size_t>(f)][k]).transpose();
+      }
+      const double weight = st.face_weight[static_cast<size_t>(f)] / st.model_area[0];
+      const double scale = st.model_scale[0], floor = st.area_floor[0];
+      const Eigen::Vector3d n = (q[1] - q[0]).cross(q[2] - q[0]);
+      const double delta = q[0].dot(n) / n.norm();  // the chord plane's distance from the centre
+      if (!(delta < split)) {
+        expected += explicit_chord_energy(q, p, scale, weight, floor, reg, edge_frames);
+        continue;
+      }
+      ++split_faces;
+      int i = 0;  // the corner opposite the longest edge
+      for (int k = 1; k < 3; ++k)
+        if ((q[(k + 1) % 3] - q[(k + 2) % 3]).norm() > (q[(i + 1) % 3] - q[(i + 2) % 3]).norm()) i = k;
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      const Eigen::Vector3d gc = q[j].cross(q[k]).normalized();
+      const Eigen::Vector3d m = (q[i] - gc.dot(q[i]) * gc).normalized();
+      // m's surface point: where the chord q_k + t (q_j - q_k) meets the ray through m.
+      Eigen::Matrix<double, 3, 2> A;
+      A.col(0) = q[j] - q[k];
+      A.col(1) = -m;
+      const Eigen::Vector2d ts = A.colPivHouseholderQr().solve(-q[k]);
+      const Eigen::Vector3d pm = p[k] + ts(0) * (p[j] - p[k]);
+      const Eigen::Vector3d h1q[3] = {q[i], q[j], m}, h1p[3] = {p[i], p[j], pm};
+      const Eigen::Vector3d h2q[3] = {q[i], m, q[k]}, h2p[3] = {p[i], pm, p[k]};
+      expected += explicit_chord_energy(h1q, h1p, scale, weight, 0.5 * floor, reg, edge_frames) +
+                  explicit_chord_energy(h2q, h2p, scale, weight, 0.5 * floor, reg, edge_frames);
+    }
+    const double got = ring_energy(st, ring, x, reg, split);
+    INFO("vertex " << v << (edge_frames ? " (edge frames)" : " (smallest singular value)"));
+    CHECK(std::abs(got - expected) <= 1e-9 * expected);
+  }
+  CHECK(split_faces > 50);
+}
+
 TEST_CASE("the area floor gives faces of tiny surface area a share of the energy", "[param][sphere][energy]") {
   // SphereState::area_floor_rel: a face's weight is its area plus that share of the mean face
   // area. A vertex of the radial capsule with one ring face shrunk to a sliver on the surface:

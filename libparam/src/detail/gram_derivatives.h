@@ -16,6 +16,8 @@
 #include <Eigen/Core>
 #include <cmath>
 
+#include "detail/sphere_state.h"
+
 namespace spherekit::detail {
 
 /// A scalar function of (E11, E22, E12) with its gradient g and symmetric Hessian
@@ -72,7 +74,7 @@ inline GramJet area_jet(double E11, double E22, double E12) {
 
 /// Energy of one small face for one model as gram_energy computes it with edge-frame cruft
 /// terms, w (T/2 + reg) + mips with T = scale N / Q, added to *acc with its derivatives.
-/// `s` is the ring's per-face record (kSurfStride layout of stretch_optimizer.cpp). Returns
+/// `s` is the ring face's record (RingScratch::surf, fields SurfField). Returns
 /// false (acc unchanged) where the energy is not finite.
 inline bool add_gram_energy_jet(double E11, double E22, double E12, const double* s, double scale, double reg_weight,
                                 GramJet* acc) {
@@ -81,8 +83,8 @@ inline bool add_gram_energy_jet(double E11, double E22, double E12, const double
   if (!(Q > 1e-24 * E11 * E22)) return false;
   const double iQ = 1 / Q;
   const double gQ[3] = {E22, E11, -2 * E12};  // Hessian of Q: d2/dE11dE22 = 1, d2/dE12^2 = -2
-  const double gN[3] = {s[12], s[11], -2 * s[13]};  // N = E22 D11 + E11 D22 - 2 E12 D12 is linear in E
-  const double N = E22 * s[11] + E11 * s[12] - 2 * E12 * s[13];
+  const double gN[3] = {s[kSurfG22], s[kSurfG11], -2 * s[kSurfG12]};  // N = E22 D11 + E11 D22 - 2 E12 D12 is linear in E
+  const double N = E22 * s[kSurfG11] + E11 * s[kSurfG22] - 2 * E12 * s[kSurfG12];
   // T Q = scale N, differentiated once and twice:
   //   grad T = (scale grad N - T grad Q) / Q,
   //   Hess T = -(grad T grad Q^T + grad Q grad T^T + T Hess Q) / Q.
@@ -93,7 +95,7 @@ inline bool add_gram_energy_jet(double E11, double E22, double E12, const double
   add_sym(hT, gT, gQ, -iQ);
   hT[3] -= T * iQ;
   hT[2] += 2 * T * iQ;
-  const double w = s[9] * (s[14] + s[10]);
+  const double w = s[kSurfWeight] * (s[kSurfArea] + s[kSurfFloor]);
   // Result = kT * (T's jet) + sum alpha_k dir_k (gradient) + sum beta_k dir_k dir_k^T
   // (Hessian) + outer products of the branches m_k = T - a_k.
   //
@@ -106,17 +108,29 @@ inline bool add_gram_energy_jet(double E11, double E22, double E12, const double
   double alpha[3], beta[3];
   double h[6] = {0, 0, 0, 0, 0, 0};
   const double L[3] = {E11, E22, E11 + E22 - 2 * E12};
-  const double num[3] = {s[11], s[12], s[11] + s[12] - 2 * s[13]};
+  const double num[3] = {s[kSurfG11], s[kSurfG22], s[kSurfG11] + s[kSurfG22] - 2 * s[kSurfG12]};
   const double kr = w * reg_weight / 3;
   double reg = 0;
+  // The reciprocals of the three L_k and of the three m_k each from one division (divisions
+  // dominate this function's cost; 1/x1 = x2 x3 / (x1 x2 x3)).
+  const double iLLL = 1 / (L[0] * L[1] * L[2]);
+  const double iL3[3] = {L[1] * L[2] * iLLL, L[0] * L[2] * iLLL, L[0] * L[1] * iLLL};
+  double a3[3], m3[3];
+  bool along3[3];
   for (int k = 0; k < 3; ++k) {
-    const double iL = 1 / L[k];
-    const double a = scale * num[k] * iL;
+    a3[k] = scale * num[k] * iL3[k];
+    along3[k] = !(T - a3[k] < a3[k]);
+    m3[k] = along3[k] ? a3[k] : T - a3[k];
+    if (!(m3[k] > 0)) return false;
+  }
+  const double iMMM = 1 / (m3[0] * m3[1] * m3[2]);
+  const double im3[3] = {m3[1] * m3[2] * iMMM, m3[0] * m3[2] * iMMM, m3[0] * m3[1] * iMMM};
+  for (int k = 0; k < 3; ++k) {
+    const double iL = iL3[k];
+    const double a = a3[k];
     const double ga = -a * iL, ha = 2 * a * iL * iL;  // along dir_k
-    const bool along = !(T - a < a);
-    const double m = along ? a : T - a;
-    if (!(m > 0)) return false;
-    const double im = 1 / m, f = im * im * im, f1 = -3 * f * im, f2 = 12 * f * im * im;
+    const bool along = along3[k];
+    const double im = im3[k], f = im * im * im, f1 = -3 * f * im, f2 = 12 * f * im * im;
     reg += f;
     if (along) {
       alpha[k] = kr * f1 * ga;
@@ -139,11 +153,11 @@ inline bool add_gram_energy_jet(double E11, double E22, double E12, const double
   h[3] += beta[2];
   h[4] -= 2 * beta[2];
   h[5] -= 2 * beta[2];
-  if (s[15] != 0) {
+  if (s[kSurfShape] != 0) {
     // MIPS T / (2 sqrt D) with D = (2 A_surf scale)^2 / Q, i.e. k N r with r = Q^-1/2:
     // grad r = -r/(2Q) grad Q, Hess r = 3r/(4Q^2) grad Q grad Q^T - r/(2Q) Hess Q.
-    if (!(s[14] > 0)) return false;
-    const double k = s[15] / (4 * s[14]);
+    if (!(s[kSurfArea] > 0)) return false;
+    const double k = s[kSurfShape] / (4 * s[kSurfArea]);
     const double r = std::sqrt(iQ);
     const double c1 = -0.5 * r * iQ;
     const double gr[3] = {c1 * gQ[0], c1 * gQ[1], c1 * gQ[2]};

@@ -134,6 +134,14 @@ inline double gram_frobenius_numerator(double E11, double E22, double E12, doubl
   return E22 * D11 + E11 * D22 - 2 * E12 * D12;
 }
 
+/// Fields of a ring face's record in RingScratch::surf (one per face and model): the face
+/// weight over the model's area, the area floor, the surface edge Gram entries |d1|^2,
+/// |d2|^2, d1.d2 (d1 = pa - pv, d2 = pb - pv, pv the moving vertex's surface point), the
+/// surface area, the shape-term weight. Only these: the energies, the accordion split
+/// included, need no surface vector arithmetic while v moves (load_ring fills them).
+enum SurfField : int { kSurfWeight = 0, kSurfFloor, kSurfG11, kSurfG22, kSurfG12, kSurfArea, kSurfShape };
+inline constexpr size_t kSurfStride = 8;  ///< one cache line per record
+
 /// Scratch memory for one vertex's 1-ring (one per thread).
 struct alignas(64) RingScratch {
   struct Face {
@@ -144,7 +152,9 @@ struct alignas(64) RingScratch {
     bool real;               ///< not a hole-filling face
   };
   std::vector<Face> faces;
-  std::vector<double> surf;  ///< per face and model: d1 (3), d2 (3), area weight (1)
+  /// Per face and model, a record of kSurfStride doubles (fields SurfField): what the face's
+  /// energy needs of the surface, constant while v moves.
+  std::vector<double> surf;
   /// Per face and model, the energy at the vertex's current point and at a trial point
   /// (ring_energy's face_energy; the Newton steps reuse the current one).
   std::vector<double> energy_here, energy_trial;

@@ -114,23 +114,23 @@ inline bool add_gram_energy_jet(double E11, double E22, double E12, const double
   // The reciprocals of the three L_k and of the three m_k each from one division (divisions
   // dominate this function's cost; 1/x1 = x2 x3 / (x1 x2 x3)).
   const double iLLL = 1 / (L[0] * L[1] * L[2]);
-  const double iL3[3] = {L[1] * L[2] * iLLL, L[0] * L[2] * iLLL, L[0] * L[1] * iLLL};
-  double a3[3], m3[3];
-  bool along3[3];
+  const double inv_L[3] = {L[1] * L[2] * iLLL, L[0] * L[2] * iLLL, L[0] * L[1] * iLLL};
+  double a_k[3], m_k[3];
+  bool along_k[3];
   for (int k = 0; k < 3; ++k) {
-    a3[k] = scale * num[k] * iL3[k];
-    along3[k] = !(T - a3[k] < a3[k]);
-    m3[k] = along3[k] ? a3[k] : T - a3[k];
-    if (!(m3[k] > 0)) return false;
+    a_k[k] = scale * num[k] * inv_L[k];
+    along_k[k] = !(T - a_k[k] < a_k[k]);
+    m_k[k] = along_k[k] ? a_k[k] : T - a_k[k];
+    if (!(m_k[k] > 0)) return false;
   }
-  const double iMMM = 1 / (m3[0] * m3[1] * m3[2]);
-  const double im3[3] = {m3[1] * m3[2] * iMMM, m3[0] * m3[2] * iMMM, m3[0] * m3[1] * iMMM};
+  const double iMMM = 1 / (m_k[0] * m_k[1] * m_k[2]);
+  const double inv_m[3] = {m_k[1] * m_k[2] * iMMM, m_k[0] * m_k[2] * iMMM, m_k[0] * m_k[1] * iMMM};
   for (int k = 0; k < 3; ++k) {
-    const double iL = iL3[k];
-    const double a = a3[k];
+    const double iL = inv_L[k];
+    const double a = a_k[k];
     const double ga = -a * iL, ha = 2 * a * iL * iL;  // along dir_k
-    const bool along = along3[k];
-    const double im = im3[k], f = im * im * im, f1 = -3 * f * im, f2 = 12 * f * im * im;
+    const bool along = along_k[k];
+    const double im = inv_m[k], f = im * im * im, f1 = -3 * f * im, f2 = 12 * f * im * im;
     reg += f;
     if (along) {
       alpha[k] = kr * f1 * ga;

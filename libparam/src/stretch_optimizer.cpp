@@ -285,9 +285,9 @@ bool load_ring(const SphereState& st, int v, RingScratch& ring, const RingIndex*
       // back) or tiny, and its pull must not depend on that. MIPS is scale-free, so the
       // hole may still shrink freely on the sphere.
       s[kSurfShape] = st.face_shape_weight.empty()
-                  ? 0.0
-                  : st.face_shape_weight[static_cast<size_t>(f)] * st.average_face_area[static_cast<size_t>(m)] /
-                        st.model_area[static_cast<size_t>(m)];
+                          ? 0.0
+                          : st.face_shape_weight[static_cast<size_t>(f)] * st.average_face_area[static_cast<size_t>(m)] /
+                                st.model_area[static_cast<size_t>(m)];
     }
   }
   return count > 0;
@@ -418,13 +418,14 @@ inline double split_face_energy(const Eigen::Vector3d* q, const double* s, doubl
   const double Eii = ei.squaredNorm();
   const double floor = 0.5 * s[kSurfFloor], shape = 0.5 * s[kSurfShape];
   // Half (m, i, j): third edge q_j - q_i, on the surface dj.
+  const double area = s[kSurfArea], weight = s[kSurfWeight];
   const double e1 = gram_face_energy(Eii, ej.squaredNorm(), ei.dot(ej), (q[j] - q[i]).squaredNorm(), Dmm,
-                                     u * u * Gjk_edge, -u * Dcross, Gjj, std::abs(u) * s[kSurfArea], floor, s[kSurfWeight], shape,
-                                     scale, reg_weight, edge_frames);
+                                     u * u * Gjk_edge, -u * Dcross, Gjj, std::abs(u) * area, floor, weight, shape, scale,
+                                     reg_weight, edge_frames);
   // Half (m, k, i): third edge q_i - q_k, on the surface dk.
   const double e2 = gram_face_energy(ek.squaredNorm(), Eii, ek.dot(ei), (q[k] - q[i]).squaredNorm(),
-                                     t * t * Gjk_edge, Dmm, t * Dcross, Gkk, std::abs(t) * s[kSurfArea], floor, s[kSurfWeight],
-                                     shape, scale, reg_weight, edge_frames);
+                                     t * t * Gjk_edge, Dmm, t * Dcross, Gkk, std::abs(t) * area, floor, weight, shape, scale,
+                                     reg_weight, edge_frames);
   return e1 + e2;
 }
 
@@ -433,7 +434,8 @@ inline double split_face_energy(const Eigen::Vector3d* q, const double* s, doubl
 inline double gram_energy(const Eigen::Vector3d& e1, const Eigen::Vector3d& e2, const double* s, double scale,
                           double reg_weight, bool edge_frames) {
   const double E11 = e1.squaredNorm(), E22 = e2.squaredNorm(), E12 = e1.dot(e2);
-  return gram_face_energy(E11, E22, E12, E11 + E22 - 2 * E12, s[kSurfG11], s[kSurfG22], s[kSurfG12], s[kSurfG11] + s[kSurfG22] - 2 * s[kSurfG12], s[kSurfArea],
+  const double D11 = s[kSurfG11], D22 = s[kSurfG22], D12 = s[kSurfG12];
+  return gram_face_energy(E11, E22, E12, E11 + E22 - 2 * E12, D11, D22, D12, D11 + D22 - 2 * D12, s[kSurfArea],
                           s[kSurfFloor], s[kSurfWeight], s[kSurfShape], scale, reg_weight, edge_frames);
 }
 

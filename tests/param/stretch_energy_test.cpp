@@ -75,21 +75,55 @@ double vertex_energy(const SphereState& st, int v, double reg, double split) {
   return ring_energy(st, ring, st.S.row(v).transpose(), reg, split);
 }
 
-// Smallest squared singular value of the affine map chord triangle (q) -> surface triangle (p),
-// times the state's scale: computed here from an explicit 2x2 Jacobian, independently of the
-// optimizer's Gram-entry formulas.
-double smallest_squared_stretch(const Eigen::Vector3d q[3], const Eigen::Vector3d p[3], double scale) {
+// The affine map chord triangle (q) -> surface triangle (p) as an explicit Jacobian J (3x2) on
+// the orthonormal domain frame (u, w) of the triangle's plane: independent of the optimizer's
+// Gram-entry formulas.
+struct ExplicitJacobian {
+  Eigen::Vector3d u, w;
+  Eigen::Matrix<double, 3, 2> J;
+};
+ExplicitJacobian explicit_jacobian(const Eigen::Vector3d q[3], const Eigen::Vector3d p[3]) {
   const Eigen::Vector3d e1 = q[1] - q[0], e2 = q[2] - q[0];
-  const Eigen::Vector3d u = e1.normalized(), w = (e2 - e2.dot(u) * u).normalized();
+  ExplicitJacobian r;
+  r.u = e1.normalized();
+  r.w = (e2 - e2.dot(r.u) * r.u).normalized();
   Eigen::Matrix2d dom;
-  dom << e1.dot(u), e2.dot(u), e1.dot(w), e2.dot(w);
+  dom << e1.dot(r.u), e2.dot(r.u), e1.dot(r.w), e2.dot(r.w);
   Eigen::Matrix<double, 3, 2> surf;
   surf.col(0) = p[1] - p[0];
   surf.col(1) = p[2] - p[0];
-  const Eigen::Matrix<double, 3, 2> J = surf * dom.inverse();
-  Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>> svd(J);
+  r.J = surf * dom.inverse();
+  return r;
+}
+
+// Smallest squared singular value of the map q -> p, times the state's scale.
+double smallest_squared_stretch(const Eigen::Vector3d q[3], const Eigen::Vector3d p[3], double scale) {
+  Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>> svd(explicit_jacobian(q, p).J);
   const double s = svd.singularValues()(1);
   return s * s * scale;
+}
+
+// A face's energy as the optimizer defines it, from the explicit Jacobian: weight (area + floor)
+// (|J|_F^2 / 2 + anti-cruft), the anti-cruft term reg / 3 sum_k min(a_k, T - a_k)^-3 along the
+// three domain edges (a_k the squared stretch along edge k, T = |J|_F^2, both times scale), or
+// with edge_frames false the collection stages' reg / g^3 (g the smallest squared singular value).
+double explicit_chord_energy(const Eigen::Vector3d q[3], const Eigen::Vector3d p[3], double scale, double weight,
+                             double floor, double reg, bool edge_frames) {
+  const ExplicitJacobian ej = explicit_jacobian(q, p);
+  const double T = ej.J.squaredNorm() * scale;
+  const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+  if (!edge_frames) {
+    const double g = smallest_squared_stretch(q, p, scale);
+    return weight * (area + floor) * (0.5 * T + reg / (g * g * g));
+  }
+  double cruft = 0;
+  const Eigen::Vector3d edges[3] = {q[1] - q[0], q[2] - q[0], q[2] - q[1]};
+  for (const Eigen::Vector3d& e : edges) {
+    const Eigen::Vector2d d(e.dot(ej.u), e.dot(ej.w));
+    const double a = (ej.J * d.normalized()).squaredNorm() * scale;
+    cruft += 1 / std::pow(std::min(a, T - a), 3);
+  }
+  return weight * (area + floor) * (0.5 * T + reg / 3 * cruft);
 }
 
 }  // namespace
@@ -460,41 +494,6 @@ TEST_CASE("a small face's accordion split measures its chord triangle's energy t
   CHECK(optimizer_settings(o).area_floor_rel == 0.03);
   CHECK(optimizer_settings(collection_sphere_options()).area_floor_rel == 1e-3);
 }
-
-namespace {
-
-// A face's energy as the optimizer defines it, computed here from an explicit Jacobian of the
-// chord triangle q -> surface triangle p: weight (area + floor) (|J|_F^2 / 2 + anti-cruft),
-// the anti-cruft term reg / 3 sum_k min(a_k, T - a_k)^-3 along the three domain edges (a_k
-// the squared stretch along edge k, T = |J|_F^2, both times scale).
-double explicit_chord_energy(const Eigen::Vector3d q[3], const Eigen::Vector3d p[3], double scale, double weight,
-                             double floor, double reg, bool edge_frames) {
-  const Eigen::Vector3d e1 = q[1] - q[0], e2 = q[2] - q[0];
-  const Eigen::Vector3d u = e1.normalized(), w = (e2 - e2.dot(u) * u).normalized();
-  Eigen::Matrix2d dom;
-  dom << e1.dot(u), e2.dot(u), e1.dot(w), e2.dot(w);
-  Eigen::Matrix<double, 3, 2> surf;
-  surf.col(0) = p[1] - p[0];
-  surf.col(1) = p[2] - p[0];
-  const Eigen::Matrix<double, 3, 2> J = surf * dom.inverse();
-  const double T = J.squaredNorm() * scale;
-  double cruft = 0;
-  const Eigen::Vector3d edges[3] = {e1, e2, e2 - e1};
-  for (const Eigen::Vector3d& e : edges) {
-    const Eigen::Vector2d d(e.dot(u), e.dot(w));
-    const double a = (J * d.normalized()).squaredNorm() * scale;
-    cruft += 1 / std::pow(std::min(a, T - a), 3);
-  }
-  const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
-  if (!edge_frames) {  // the collection stages' form: reg / g^3, g the smallest squared singular value
-    Eigen::JacobiSVD<Eigen::Matrix<double, 3, 2>> svd(J);
-    const double g = svd.singularValues()(1) * svd.singularValues()(1) * scale;
-    return weight * (area + floor) * (0.5 * T + reg / (g * g * g));
-  }
-  return weight * (area + floor) * (0.5 * T + reg / 3 * cruft);
-}
-
-}  // namespace
 
 TEST_CASE("the accordion split's energy from Gram entries is the split formed with explicit Jacobians",
           "[param][sphere][energy]") {

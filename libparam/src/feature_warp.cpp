@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include <Eigen/Cholesky>
 
@@ -57,6 +58,66 @@ bool any_flipped(const RowMat3i& F, const RowMat3d& S) {
 }
 
 }  // namespace
+
+SupportCells::SupportCells(const std::vector<Eigen::Vector3d>& centres, double support)
+    : centres_(centres) {
+  // Cells of about half the support (a cell's list then holds the centres within about 1.4
+  // supports of its middle), at most 32 per axis; they tile [-1, 1] exactly. Each centre is
+  // entered, in ascending order, into the cells its support reaches (two passes over the
+  // same cells: counts, then entries).
+  n_ = std::clamp(static_cast<int>(std::ceil(4.0 / support)), 1, 32);
+  cell_ = 2.0 / n_;
+  start_.assign(static_cast<size_t>(n_) * static_cast<size_t>(n_) * static_cast<size_t>(n_) + 1, 0);
+  // A centre farther than the support from a cell's box contributes exactly zero to every
+  // point of it (the kernel is 0 from r >= 1); the box is widened by kMargin, far above the
+  // rounding of the cell index and of r, and covers a unit vector's coordinates rounded a
+  // little past +-1 (clamped into the outermost cells).
+  constexpr double kMargin = 1e-9;
+  const double reach2 = support * support * (1 + 1e-6);
+  auto for_each_cell = [&](const Eigen::Vector3d& c, auto&& emit) {
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::clamp(static_cast<int>(std::floor((c[a] - support + 1 - kMargin) / cell_)), 0, n_ - 1);
+      hi[a] = std::clamp(static_cast<int>(std::floor((c[a] + support + 1 + kMargin) / cell_)), 0, n_ - 1);
+    }
+    for (int i = lo[0]; i <= hi[0]; ++i)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int k = lo[2]; k <= hi[2]; ++k) {
+          const int idx[3] = {i, j, k};
+          double d2 = 0;
+          for (int a = 0; a < 3; ++a) {
+            const double blo = -1 + idx[a] * cell_ - kMargin, bhi = -1 + (idx[a] + 1) * cell_ + kMargin;
+            const double d = c[a] < blo ? blo - c[a] : c[a] > bhi ? c[a] - bhi : 0.0;
+            d2 += d * d;
+          }
+          if (d2 < reach2) emit((static_cast<size_t>(i) * static_cast<size_t>(n_) + static_cast<size_t>(j)) *
+                                    static_cast<size_t>(n_) + static_cast<size_t>(k));
+        }
+  };
+  for (const auto& c : centres) for_each_cell(c, [&](size_t key) { ++start_[key + 1]; });
+  for (size_t key = 0; key + 1 < start_.size(); ++key) start_[key + 1] += start_[key];
+  entries_.resize(static_cast<size_t>(start_.back()));
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  for (size_t j = 0; j < centres.size(); ++j)
+    for_each_cell(centres[j], [&](size_t key) { entries_[static_cast<size_t>(fill[key]++)] = static_cast<int>(j); });
+}
+
+std::span<const int> SupportCells::near(const Eigen::Vector3d& x) {
+  int idx[3];
+  for (int a = 0; a < 3; ++a) {
+    // Unit vectors are within [-1, 1] up to rounding; anything else (never in a map) is
+    // given every centre.
+    if (!(std::abs(x[a]) <= 1 + 1e-12)) {
+      if (all_.size() != centres_.size())
+        for (int j = static_cast<int>(all_.size()); j < static_cast<int>(centres_.size()); ++j) all_.push_back(j);
+      return all_;
+    }
+    idx[a] = std::clamp(static_cast<int>(std::floor((x[a] + 1) / cell_)), 0, n_ - 1);
+  }
+  const size_t key = (static_cast<size_t>(idx[0]) * static_cast<size_t>(n_) + static_cast<size_t>(idx[1])) *
+                         static_cast<size_t>(n_) + static_cast<size_t>(idx[2]);
+  return {entries_.data() + start_[key], entries_.data() + start_[key + 1]};
+}
 
 std::vector<int> spread_subset(const std::vector<Eigen::Vector3d>& targets, int count) {
   const int k = static_cast<int>(targets.size());
@@ -234,10 +295,13 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
       return Status(ErrorCode::SolverFailed, "feature warp: a face flips however small the step");
     }
     const double t1 = std::min(1.0, t + dt);
+    SupportCells cells(cur, support);  // the features' supports at their current positions
+    K.setZero();
     for (int i = 0; i < k; ++i) {
       const Eigen::Vector3d next = t1 >= 1 ? q[static_cast<size_t>(i)] : slerp(start[static_cast<size_t>(i)], q[static_cast<size_t>(i)], t1);
       D.row(i) = (next - cur[static_cast<size_t>(i)]).transpose();
-      for (int j = 0; j < k; ++j) K(i, j) = wendland((cur[static_cast<size_t>(i)] - cur[static_cast<size_t>(j)]).norm() * inv_h);
+      for (int j : cells.near(cur[static_cast<size_t>(i)]))
+        K(i, j) = wendland((cur[static_cast<size_t>(i)] - cur[static_cast<size_t>(j)]).norm() * inv_h);
       K(i, i) += 1e-9;  // ridge: the features are snapped below, the field need not be exact there
     }
     C = K.ldlt().solve(D);
@@ -249,7 +313,7 @@ Status warp_features_to_targets(const RowMat3d& X, const RowMat3i& F, const std:
     for (Eigen::Index v = 0; v < trial.rows(); ++v) {
       const Eigen::Vector3d x = S->row(v).transpose();
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
-      for (int j = 0; j < k; ++j) {
+      for (int j : cells.near(x)) {
         const double r = (x - cur[static_cast<size_t>(j)]).norm() * inv_h;
         if (r < 1) d += wendland(r) * C.row(j).transpose();
       }

@@ -54,7 +54,8 @@ TEST_CASE("the support grid lists every feature whose kernel reaches a point, in
       const double cell = 2.0 / cells.cells_per_axis();
       long listed = 0;
       int points = 0;
-      for (int p = 0; p < 2000; ++p, ++points) require_lists_contributors(cells, centres, support, random_unit(rng), &listed);
+      for (int p = 0; p < 2000; ++p, ++points)
+        require_lists_contributors(cells, centres, support, random_unit(rng), &listed);
       // Near every centre, at the distance where the kernel ends.
       for (const auto& c : centres)
         for (int p = 0; p < 4; ++p, ++points) {

@@ -59,8 +59,7 @@ bool any_flipped(const RowMat3i& F, const RowMat3d& S) {
 
 }  // namespace
 
-SupportCells::SupportCells(const std::vector<Eigen::Vector3d>& centres, double support)
-    : centres_(centres) {
+SupportCells::SupportCells(const std::vector<Eigen::Vector3d>& centres, double support) {
   // Cells of about half the support (a cell's list then holds the centres within about 1.4
   // supports of its middle), at most 32 per axis; they tile [-1, 1] exactly. Each centre is
   // entered, in ascending order, into the cells its support reaches (two passes over the
@@ -90,8 +89,7 @@ SupportCells::SupportCells(const std::vector<Eigen::Vector3d>& centres, double s
             const double d = c[a] < blo ? blo - c[a] : c[a] > bhi ? c[a] - bhi : 0.0;
             d2 += d * d;
           }
-          if (d2 < reach2) emit((static_cast<size_t>(i) * static_cast<size_t>(n_) + static_cast<size_t>(j)) *
-                                    static_cast<size_t>(n_) + static_cast<size_t>(k));
+          if (d2 < reach2) emit(key(idx));
         }
   };
   for (const auto& c : centres) for_each_cell(c, [&](size_t key) { ++start_[key + 1]; });
@@ -100,23 +98,25 @@ SupportCells::SupportCells(const std::vector<Eigen::Vector3d>& centres, double s
   std::vector<int> fill(start_.begin(), start_.end() - 1);
   for (size_t j = 0; j < centres.size(); ++j)
     for_each_cell(centres[j], [&](size_t key) { entries_[static_cast<size_t>(fill[key]++)] = static_cast<int>(j); });
+  all_.resize(centres.size());
+  for (size_t j = 0; j < centres.size(); ++j) all_[j] = static_cast<int>(j);
 }
 
-std::span<const int> SupportCells::near(const Eigen::Vector3d& x) {
+size_t SupportCells::key(const int* idx) const {
+  const size_t n = static_cast<size_t>(n_);
+  return (static_cast<size_t>(idx[0]) * n + static_cast<size_t>(idx[1])) * n + static_cast<size_t>(idx[2]);
+}
+
+std::span<const int> SupportCells::near(const Eigen::Vector3d& x) const {
   int idx[3];
   for (int a = 0; a < 3; ++a) {
     // Unit vectors are within [-1, 1] up to rounding; anything else (never in a map) is
     // given every centre.
-    if (!(std::abs(x[a]) <= 1 + 1e-12)) {
-      if (all_.size() != centres_.size())
-        for (int j = static_cast<int>(all_.size()); j < static_cast<int>(centres_.size()); ++j) all_.push_back(j);
-      return all_;
-    }
+    if (!(std::abs(x[a]) <= 1 + 1e-12)) return all_;
     idx[a] = std::clamp(static_cast<int>(std::floor((x[a] + 1) / cell_)), 0, n_ - 1);
   }
-  const size_t key = (static_cast<size_t>(idx[0]) * static_cast<size_t>(n_) + static_cast<size_t>(idx[1])) *
-                         static_cast<size_t>(n_) + static_cast<size_t>(idx[2]);
-  return {entries_.data() + start_[key], entries_.data() + start_[key + 1]};
+  const size_t k = key(idx);
+  return {entries_.data() + start_[k], entries_.data() + start_[k + 1]};
 }
 
 std::vector<int> spread_subset(const std::vector<Eigen::Vector3d>& targets, int count) {

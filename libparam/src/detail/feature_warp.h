@@ -96,11 +96,11 @@ class SupportCells {
   SupportCells(const std::vector<Eigen::Vector3d>& centres, double support);
   /// Ascending indices of the centres whose support may reach x (every centre c with
   /// |x - c| < support is listed; a point outside [-1, 1]^3 gets every centre).
-  std::span<const int> near(const Eigen::Vector3d& x);
+  std::span<const int> near(const Eigen::Vector3d& x) const;
   int cells_per_axis() const { return n_; }
 
  private:
-  const std::vector<Eigen::Vector3d>& centres_;
+  size_t key(const int* idx) const;  // a cell's index from its three coordinates
   double cell_;
   int n_;
   std::vector<int> start_, entries_;  // per cell (CSR): the centres listed for it

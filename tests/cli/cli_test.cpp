@@ -656,3 +656,37 @@ TEST_CASE("bench compares with a reference measured in the same run", "[cli]") {
   CHECK(bad.err.find("nowhere") != std::string::npos);
   CHECK_FALSE(fs::exists(out2));
 }
+
+// bench runs each mesh in a child of its own executable. When the file it was started from is
+// replaced while it runs (a rebuild or an upgrade during a long bench), the children still
+// start: here the stand-in reference deletes the copy of spherekit the bench runs from after
+// the first mesh, and the second mesh is measured all the same (before, spawning the deleted
+// file's name failed: "cannot start child process").
+TEST_CASE("bench measures every mesh after its executable file was removed", "[cli]") {
+  const std::string dir = spherekit::test::temp_dir("cli_bench_removed_exe");
+  const std::string a = write_obj(dir, "a.obj", spherekit::test::random_blob(2, 5));
+  const std::string b = write_obj(dir, "b.obj", spherekit::test::random_blob(2, 6));
+  const std::string copy = dir + "/spherekit_copy";
+  fs::copy_file(SPHEREKIT_EXE, copy, fs::copy_options::overwrite_existing);
+  fs::permissions(copy, fs::perms::owner_all);
+  const std::string kit = dir + "/mpl";
+  fs::create_directories(kit + "/bin/unix");
+  write_text(kit + "/bin/unix/SphereParam", "#!/bin/sh\nexit 1\n");
+  const std::string script = dir + "/removing_sphereparam.sh";
+  write_text(script, "#!/bin/bash\nrm -f " + quote(copy) + "\nexec " + quote(SPHEREKIT_EXE) +
+                         " param \"$1\" -o \"$2\" --quiet\n");
+  const std::string out = dir + "/bench.json";
+  CliRun r = spherekit::test::run_cli(copy, "bench " + quote(a) + " " + quote(b) + " --reference-dir " + quote(kit) +
+                                                " --reference-script " + quote(script) + " --threads 1 -o " + quote(out),
+                                      dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK_FALSE(fs::exists(copy));
+  const json j = parse_json(slurp(out));
+  REQUIRE(j["rows"].size() == 2);
+  for (const json& row : j["rows"]) {
+    CHECK(row["status"] == "ok");
+    CHECK(row["flipped_faces"] == 0);
+    CHECK(row["reference"]["efficiency"].get<double>() == Approx(row["efficiency"].get<double>()).epsilon(1e-9));
+  }
+}

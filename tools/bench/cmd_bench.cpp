@@ -104,10 +104,10 @@ struct ChildRun {
 
 // Runs program `exe` with `args` and extra environment entries `env` ("NAME=value"); stdin
 // and stdout go to /dev/null (the child is --quiet anyway), stderr stays ours so its
-// one-line error shows up in the bench output.
+// one-line error shows up in the bench output. `argv0` is the child's name (default `exe`).
 Result<ChildRun> run_program(const fs::path& exe, const std::vector<std::string>& args,
-                             const std::vector<std::string>& env = {}) {
-  std::vector<std::string> argv_strings = {exe.string()};
+                             const std::vector<std::string>& env = {}, const std::string& argv0 = {}) {
+  std::vector<std::string> argv_strings = {argv0.empty() ? exe.string() : argv0};
   argv_strings.insert(argv_strings.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& s : argv_strings) argv.push_back(s.data());
@@ -164,12 +164,18 @@ Result<ChildRun> run_program(const fs::path& exe, const std::vector<std::string>
   return run;
 }
 
-// Runs this executable with `args`.
+// Runs this executable with `args`, through /proc/self/exe: that is this very binary even
+// when the file it was started from has been replaced since (a rebuild or a package upgrade
+// during a long bench), where the link's target names a deleted file and spawning by that
+// name failed ("cannot start child process") for every later mesh. The child keeps the
+// file's name as argv[0].
 Result<ChildRun> run_child(const std::vector<std::string>& args) {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (ec) return Status(ErrorCode::Internal, "cannot locate the spherekit executable: " + ec.message());
-  return run_program(exe, args);
+  std::string name = exe.string();
+  if (const std::string gone = " (deleted)"; name.ends_with(gone)) name.resize(name.size() - gone.size());
+  return run_program("/proc/self/exe", args, {}, name);
 }
 
 // The reference implementation measured in the same run (--reference-dir): Praun & Hoppe's

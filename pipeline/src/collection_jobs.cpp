@@ -211,6 +211,9 @@ Result<std::optional<RefinedMember>> refine_added_member(const formats::Collecti
     // Collections written before the stretch polish have no entry: their members were
     // refined without it, and an added member is refined as they were.
     ro.stretch_passes = r.value("stretch_passes", 0);
+    // Likewise for the growing sample counts: before them every round took `samples`.
+    ro.sample_growth = r.value("sample_growth", 1);
+    ro.max_samples = r.value("max_samples", ro.max_samples);
   }
   ro.template_mesh = 0;
   ro.threads = 1;
@@ -297,7 +300,9 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
                                      {"damping", o.refinement.damping},
                                      {"rounds", o.refinement.rounds},
                                      {"samples", o.refinement.samples},
-                                     {"stretch_passes", o.refinement.stretch_passes}};
+                                     {"stretch_passes", o.refinement.stretch_passes},
+                                     {"sample_growth", o.refinement.sample_growth},
+                                     {"max_samples", o.refinement.max_samples}};
   if (!refinement_failure.empty()) {
     man.method = "consistent (steps 1-2: reference locations; step 6 failed)";
     man.extra["refinement_failure"] = refinement_failure;

@@ -120,6 +120,8 @@ TEST_CASE("consistent writes a collection; add grows it; correspond uses it", "[
   // The collection was made with the correspondence refinement (the default): consistent
   // recorded it per member, and add refined the new map against the reference the same way.
   CHECK(man["options"]["refine_correspondence"] == true);
+  CHECK(man["options"]["refinement"]["sample_growth"] == 2);
+  CHECK(man["options"]["refinement"]["max_samples"] == 512);
   CHECK(man["meshes"][0]["result"]["correspondence_refinement"]["note"] == "template");
   for (int i : {1, 2}) {
     INFO(man["meshes"][i]["name"]);
@@ -237,4 +239,42 @@ TEST_CASE("collection commands fail with one line and leave nothing behind", "[c
   CHECK(r.err.find("collection.json") != std::string::npos);
   r = sk("correspond " + q(dir + "/nowhere") + " " + q(a) + " " + q(b) + " --points " + q(dir + "/busy/keep.txt"), dir);
   CHECK(r.exit_code == 4);
+}
+
+// The refinement's later rounds flow onto more samples (256, 512, 512); a collection
+// written before that has no `sample_growth` entry, and add refines a member as its members
+// were refined: 256 samples in every round.
+TEST_CASE("add refines a new member with the sample counts the collection was made with", "[cli][collection]") {
+  const std::string dir = spherekit::test::temp_dir("cli_collection_growth");
+  const std::string s = dir + "/samples", col = dir + "/col";
+  REQUIRE(sk("samples -o " + q(s) + " --members 3 --vertices 900", dir).exit_code == 0);
+  CliRun r = sk("consistent -o " + q(col) + " " + q(s + "/sample_a.obj") + " " + q(s + "/sample_b.obj") +
+                    " --remesh-size 33 --effort 1 -q",
+                dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  json man = read_json(col + "/collection.json");
+  REQUIRE(man["options"]["refinement"]["sample_growth"] == 2);
+  const json& b = man["meshes"][1]["result"]["correspondence_refinement"];
+  INFO(b.dump());
+  REQUIRE(b["refined"] == true);
+  REQUIRE(b["rounds"] == 3);
+  CHECK(b["samples"].get<int>() == 512);
+  // The same collection as one written before the growing counts.
+  man["options"]["refinement"].erase("sample_growth");
+  {
+    std::ofstream f(col + "/collection.json", std::ios::binary | std::ios::trunc);
+    f << man.dump(2);
+  }
+  // sample_b again (its flows went through at 512 above): now 256 in every round.
+  r = sk("add " + q(col) + " " + q(s + "/sample_b.obj") + " --replace --effort 1 -q", dir);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  man = read_json(col + "/collection.json");
+  REQUIRE(man["meshes"][1]["name"] == "sample_b");
+  const json& c = man["meshes"][1]["result"]["correspondence_refinement"];
+  INFO(c.dump());
+  REQUIRE(c["refined"] == true);
+  REQUIRE(c["rounds"] == 3);
+  CHECK(c["samples"] == 256);
 }

@@ -54,8 +54,15 @@ struct RefineCorrespondenceOptions {
   /// Fit-and-flow rounds; each starts from the previous round's map. Shape-defining.
   int rounds = 3;
   /// Member vertices (farthest-point samples) whose fitted partners the map flows onto in
-  /// each round. Shape-defining.
+  /// the first round. Shape-defining.
   int samples = 256;
+  /// Each later round flows onto this many times the samples the round before carried, up
+  /// to max_samples (256, 512, 512; a flow that fails halves its count). 1 = the same count
+  /// every round, as collections refined before it were (their manifests have no entry).
+  /// Shape-defining.
+  int sample_growth = 2;
+  /// The most samples a grown round takes (never fewer than `samples`). Shape-defining.
+  int max_samples = 512;
   /// Final passes of the stretch optimizer after each flow (features fixed, the unconstrained
   /// stage's weights): they take out the stretch the flow leaves between its samples. 0 =
   /// none. Shape-defining.

@@ -214,6 +214,7 @@ Result<std::optional<RefinedMember>> refine_added_member(const formats::Collecti
     // Likewise for the growing sample counts: before them every round took `samples`.
     ro.sample_growth = r.value("sample_growth", 1);
     ro.max_samples = r.value("max_samples", ro.max_samples);
+    ro.vertices_per_sample = r.value("vertices_per_sample", ro.vertices_per_sample);
   }
   ro.template_mesh = 0;
   ro.threads = 1;
@@ -302,7 +303,8 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
                                      {"samples", o.refinement.samples},
                                      {"stretch_passes", o.refinement.stretch_passes},
                                      {"sample_growth", o.refinement.sample_growth},
-                                     {"max_samples", o.refinement.max_samples}};
+                                     {"max_samples", o.refinement.max_samples},
+                                     {"vertices_per_sample", o.refinement.vertices_per_sample}};
   if (!refinement_failure.empty()) {
     man.method = "consistent (steps 1-2: reference locations; step 6 failed)";
     man.extra["refinement_failure"] = refinement_failure;

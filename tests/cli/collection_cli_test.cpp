@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -241,9 +242,10 @@ TEST_CASE("collection commands fail with one line and leave nothing behind", "[c
   CHECK(r.exit_code == 4);
 }
 
-// The refinement's later rounds flow onto more samples (256, 512, 512); a collection
-// written before that has no `sample_growth` entry, and add refines a member as its members
-// were refined: 256 samples in every round.
+// The refinement's later rounds flow onto more samples (256, 512, 512), at most one per 8
+// member vertices (these 900-vertex members keep 256); a collection written before that has no
+// `sample_growth` entry, and add refines a member as its members were refined: 256 samples in
+// every round, whatever the other entries say.
 TEST_CASE("add refines a new member with the sample counts the collection was made with", "[cli][collection]") {
   const std::string dir = spherekit::test::temp_dir("cli_collection_growth");
   const std::string s = dir + "/samples", col = dir + "/col";
@@ -255,26 +257,33 @@ TEST_CASE("add refines a new member with the sample counts the collection was ma
   REQUIRE(r.exit_code == 0);
   json man = read_json(col + "/collection.json");
   REQUIRE(man["options"]["refinement"]["sample_growth"] == 2);
-  const json& b = man["meshes"][1]["result"]["correspondence_refinement"];
-  INFO(b.dump());
-  REQUIRE(b["refined"] == true);
-  REQUIRE(b["rounds"] == 3);
-  CHECK(b["samples"].get<int>() == 512);
-  // The same collection as one written before the growing counts.
-  man["options"]["refinement"].erase("sample_growth");
+  REQUIRE(man["options"]["refinement"]["vertices_per_sample"] == 8);
   {
-    std::ofstream f(col + "/collection.json", std::ios::binary | std::ios::trunc);
-    f << man.dump(2);
+    const json& b = man["meshes"][1]["result"]["correspondence_refinement"];
+    INFO(b.dump());
+    REQUIRE(b["refined"] == true);
+    REQUIRE(b["rounds"] == 3);
+    CHECK(b["samples"] == 256);
   }
-  // sample_b again (its flows went through at 512 above): now 256 in every round.
-  r = sk("add " + q(col) + " " + q(s + "/sample_b.obj") + " --replace --effort 1 -q", dir);
-  INFO("stderr: " << r.err);
-  REQUIRE(r.exit_code == 0);
-  man = read_json(col + "/collection.json");
-  REQUIRE(man["meshes"][1]["name"] == "sample_b");
-  const json& c = man["meshes"][1]["result"]["correspondence_refinement"];
-  INFO(c.dump());
-  REQUIRE(c["refined"] == true);
-  REQUIRE(c["rounds"] == 3);
-  CHECK(c["samples"] == 256);
+  // add follows the manifest: one sample per vertex allowed, sample_b grows to 512 ...
+  auto readd_b = [&](const std::function<void(json&)>& edit) {
+    edit(man["options"]["refinement"]);
+    {
+      std::ofstream f(col + "/collection.json", std::ios::binary | std::ios::trunc);
+      f << man.dump(2);
+    }
+    CliRun a = sk("add " + q(col) + " " + q(s + "/sample_b.obj") + " --replace --effort 1 -q", dir);
+    INFO("stderr: " << a.err);
+    REQUIRE(a.exit_code == 0);
+    man = read_json(col + "/collection.json");
+    REQUIRE(man["meshes"][1]["name"] == "sample_b");
+    const json c = man["meshes"][1]["result"]["correspondence_refinement"];
+    INFO(c.dump());
+    REQUIRE(c["refined"] == true);
+    REQUIRE(c["rounds"] == 3);
+    return c["samples"].get<int>();
+  };
+  CHECK(readd_b([](json& o) { o["vertices_per_sample"] = 1; }) == 512);
+  // ... and in a collection written before the growing counts, 256 in every round.
+  CHECK(readd_b([](json& o) { o.erase("sample_growth"); }) == 256);
 }

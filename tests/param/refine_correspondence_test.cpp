@@ -202,31 +202,37 @@ TEST_CASE("refinement works with holes in the template, and refuses bad argument
   bad.stretch_passes = 3;
   bad.sample_growth = 0;
   CHECK(refine_correspondence(meshes, features, maps, bad).status().code() == ErrorCode::InvalidArgument);
+  bad.sample_growth = 2;
+  bad.vertices_per_sample = 0;
+  CHECK(refine_correspondence(meshes, features, maps, bad).status().code() == ErrorCode::InvalidArgument);
 }
 
 // Later rounds flow onto more samples: 256, then twice as many up to max_samples, or as many
-// as the member has (every vertex but the feature); with sample_growth 1 every round takes
-// 256, as collections refined before it did. The finer flows agree at least as well.
+// as the member has (every vertex but the feature), or one per vertices_per_sample vertices
+// (never fewer than 256); with sample_growth 1 every round takes 256, as collections refined
+// before it did. The finer flows agree at least as well.
 TEST_CASE("each refinement round flows onto sample_growth times the samples of the last", "[refine]") {
   const TwistCase c = twist_case();
   const RowMat3d S1 = twisted(c.St, c.St.row(c.feature).transpose(), 0.5);
   std::vector<TriMesh> meshes{c.tmpl, c.copy};
   std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
-  auto refine = [&](int growth, RefinedMember* rep, int most = 512) {
+  auto refine = [&](int growth, RefinedMember* rep, int most = 512, int per_sample = 1) {
     std::vector<RowMat3d> maps{c.St, S1};
     RefineCorrespondenceOptions o;
     o.threads = 1;
     o.sample_growth = growth;
     o.max_samples = most;
+    o.vertices_per_sample = per_sample;
     auto r = refine_correspondence(meshes, features, maps, o);
     REQUIRE(r.ok());
     *rep = r->members[1];
     REQUIRE(rep->refined);
     return maps[1];
   };
-  RefinedMember same, grown, all;
+  RefinedMember same, grown, all, sparse;
   const RowMat3d Ss = refine(1, &same), Sg = refine(2, &grown);
   refine(2, &all, 4096);
+  refine(2, &sparse, 512, 8);  // the default density: this small member keeps 256
   const int nv = static_cast<int>(c.copy.V.rows());
   REQUIRE(nv - 1 > 512);
   REQUIRE(nv - 1 < 1024);
@@ -236,6 +242,8 @@ TEST_CASE("each refinement round flows onto sample_growth times the samples of t
   CHECK(same.samples == 256);
   CHECK(grown.samples == 512);
   CHECK(all.samples == nv - 1);
+  REQUIRE(nv / 8 < 256);
+  CHECK(sparse.samples == 256);
   CHECK(count_flipped_faces(c.copy.F, Sg) == 0);
   CHECK(Sg.row(c.feature) == c.St.row(c.feature));
   const double e_same = copy_error(c.tmpl, c.St, c.copy, Ss), e_grown = copy_error(c.tmpl, c.St, c.copy, Sg);
@@ -276,10 +284,8 @@ TEST_CASE("the stretch polish after each flow raises the efficiency and keeps th
   // ... while the agreement the fit made stays.
   const double e_plain = copy_error(c.tmpl, c.St, c.copy, Sf), e_polished = copy_error(c.tmpl, c.St, c.copy, Sp);
   INFO("error before " << before << ", unpolished " << e_plain << ", polished " << e_polished);
-  // (The flow onto 256, 512 and 512 samples leaves 0.3% of the twist here, the polish gives
-  // back a few tenths of a percent: at most 1% of it.)
   CHECK(e_polished < 0.35 * before);
-  CHECK(e_polished - e_plain < 0.01 * before);
+  CHECK(e_polished < 1.25 * e_plain);
 }
 
 namespace {

@@ -63,6 +63,10 @@ struct RefineCorrespondenceOptions {
   int sample_growth = 2;
   /// The most samples a grown round takes (never fewer than `samples`). Shape-defining.
   int max_samples = 512;
+  /// A grown round takes at most one sample per this many member vertices (never fewer than
+  /// `samples`): denser samples than that ask the flow for detail at the triangles' own
+  /// scale, where it fails. Shape-defining.
+  int vertices_per_sample = 8;
   /// Final passes of the stretch optimizer after each flow (features fixed, the unconstrained
   /// stage's weights): they take out the stretch the flow leaves between its samples. 0 =
   /// none. Shape-defining.

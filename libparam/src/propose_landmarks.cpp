@@ -454,6 +454,17 @@ constexpr double kEfficiencyWeight = 0.35;
 // Weight of the mean pair error above the cheapest candidate's: 0.05 (the window's edge)
 // costs 0.15 of correlation.
 constexpr double kCostWeight = 3.0;
+// Where the signal is too weak to decide between its best two (best raw correlation below
+// kSphereInformative), a candidate whose constrained map is at least this many times as
+// efficient as every other candidate's is kept instead of the turns' pick: the swapped limbs
+// of a near-symmetric body twist the member's map. TOSCA cat2 (reference cat9, six
+// extremities): best correlations 0.25 (swapped limbs) and 0.15 (right), efficiencies 0.286
+// and 0.361, the right one 1.15x every other; the turns had picked the swap, and with its
+// ears matched right in the fine stage that member's map was twisted (correspondence 0.127
+// against 0.039 with the given files). Where the signal is strong it is not consulted: on
+// FAUST a turned-round body costs little stretch (0.182 against the right 0.164 on one
+// member), and on generated hands five close fingertips scatter the efficiencies.
+constexpr double kEfficiencyDecisive = 1.1;
 // Agreements (correlations) closer than this do not decide.
 constexpr double kSphereMargin = 0.05;
 // A best raw correlation below this says the constrained maps do not carry the shape at all
@@ -721,7 +732,8 @@ bool resolve_by_sphere(const std::vector<TriMesh>& meshes, const std::vector<Mem
       int turns_c = -1;
       for (const auto& sc : scored)
         if (cands[sc.second].a.to == ma.to[i]) turns_c = sc.second;
-      const int keep = detail::ambiguous_sphere_choice(scored, turns_c, raw_top, kSphereMargin, kSphereInformative);
+      const int keep = detail::ambiguous_sphere_choice(scored, turns_c, raw_top, kSphereMargin, kSphereInformative,
+                                                       effs, kEfficiencyDecisive);
       if (keep >= 0 && keep != turns_c) {
         adopt(cands[keep]);
         mm.mirror_resolved = false;

@@ -406,3 +406,27 @@ TEST_CASE("transfer through the same map is the identity, and the error of a per
   CHECK_FALSE(correspondence_error(s.mesh, predicted, {}).ok());
   CHECK_FALSE(transfer_points(s.mesh, u->map.S.topRows(10), pts, s.mesh, u->map.S).ok());
 }
+
+// The measure is the edge graph's shortest path plus the straight step into the predicted
+// point's face, each edge counted once at its length. (shared/tools/evalcorr.py builds its
+// graph from every face's three edges with scipy's coo_matrix, whose conversion sums the two
+// faces' copies of an edge: twice each length, so its means are up to twice these.)
+TEST_CASE("the correspondence error is the edge-graph geodesic over sqrt(area), each edge once",
+          "[param][correspondence]") {
+  const TriMesh oct = test::octahedron();  // edges sqrt(2), area 8 * sqrt(3)/4 * 2 = 4 sqrt(3)
+  const double unit = 1.0 / std::sqrt(4.0 * std::sqrt(3.0));
+  // Predicted at +x (vertex 0); truths: itself, a neighbour (+y), the opposite vertex (-x).
+  const std::vector<SurfacePoint> at_px(3, vertex_surface_point(oct, 0));
+  auto e = correspondence_error(oct, at_px, {0, 2, 1});
+  REQUIRE(e.ok());
+  CHECK(std::abs(e->max - 2.0 * std::sqrt(2.0) * unit) < 1e-12);  // two edges to the opposite vertex
+  CHECK(std::abs(e->mean - (0.0 + std::sqrt(2.0) + 2.0 * std::sqrt(2.0)) * unit / 3.0) < 1e-12);
+  CHECK(std::abs(e->median - std::sqrt(2.0) * unit) < 1e-12);
+  // A predicted point inside face {0, 2, 4} at its centroid, true partner -x: the shortest of
+  // (corner's path + straight step to the centroid); from +y or +z: one edge + the step.
+  const SurfacePoint centre{0, Eigen::Vector3d(1.0, 1.0, 1.0) / 3.0};
+  auto c = correspondence_error(oct, {centre}, {1});
+  REQUIRE(c.ok());
+  const double step = (Eigen::Vector3d(0, 1, 0) - Eigen::Vector3d(1, 1, 1) / 3.0).norm();
+  CHECK(std::abs(c->mean - (std::sqrt(2.0) + step) * unit) < 1e-12);
+}

@@ -82,8 +82,28 @@ double correspondence_agreement(const TriMesh& ref, const RowMat3d& S_ref, const
 namespace spherekit::detail {
 
 int ambiguous_sphere_choice(const std::vector<std::pair<double, int>>& scored, int turns_pick, double raw_top,
-                            double margin, double informative) {
-  if (scored.empty() || raw_top < informative) return turns_pick;
+                            double margin, double informative, const std::vector<double>& efficiency,
+                            double decisive_ratio) {
+  if (scored.empty()) return turns_pick;
+  if (raw_top < informative) {
+    // The most efficient map, if clearly so (every other scored candidate's efficiency at
+    // most 1 / decisive_ratio of it); else the turns' pick.
+    int best = -1;
+    double first = 0, second = 0;
+    for (const auto& sc : scored) {
+      const int c = sc.second;
+      const double e = c >= 0 && c < static_cast<int>(efficiency.size()) ? efficiency[static_cast<std::size_t>(c)] : 0.0;
+      if (e > first) {
+        second = first;
+        first = e;
+        best = c;
+      } else {
+        second = std::max(second, e);
+      }
+    }
+    if (decisive_ratio > 0 && best >= 0 && first >= decisive_ratio * second) return best;
+    return turns_pick;
+  }
   const double top = scored.front().first;
   int cheapest = -1;
   for (const auto& [score, c] : scored) {

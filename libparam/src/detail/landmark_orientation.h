@@ -45,8 +45,12 @@ namespace spherekit::detail {
 /// test's signal is weak (its best raw correlation `raw_top` below `informative`) or when it
 /// scores within `margin` of the best. Otherwise the test has ruled the turns' pick out
 /// without deciding between its best few, and the cheapest of those within `margin` of the
-/// best is kept. Returns the candidate to keep.
+/// best is kept. Where the signal is weak, `efficiency` (the constrained map's stretch
+/// efficiency per candidate number; empty: not used) still decides when one scored
+/// candidate's map is at least `decisive_ratio` times as efficient as every other scored
+/// one's: a swapped assignment twists the member's map. Returns the candidate to keep.
 int ambiguous_sphere_choice(const std::vector<std::pair<double, int>>& scored, int turns_pick, double raw_top,
-                            double margin, double informative);
+                            double margin, double informative, const std::vector<double>& efficiency = {},
+                            double decisive_ratio = 0);
 
 }  // namespace spherekit::detail

@@ -500,6 +500,13 @@ TEST_CASE("samples writes meshes and landmarks that check accepts", "[cli]") {
     CliRun c = run_cli("check " + quote(obj), dir);
     CHECK(c.exit_code == 0);
   }
+  // -q: the same files, nothing printed.
+  const std::string quiet_out = dir + "/quiet";
+  CliRun q = run_cli("samples -q -o " + quote(quiet_out) + " --members 2 --target-vertices 800", dir);
+  REQUIRE(q.exit_code == 0);
+  CHECK(q.out.empty());
+  CHECK(q.err.empty());
+  for (const std::string& f : files_in(out)) CHECK(slurp(out + "/" + f) == slurp(quiet_out + "/" + f));
 }
 
 TEST_CASE("run maps given meshes and reports failures but keeps going", "[cli]") {
@@ -550,6 +557,14 @@ TEST_CASE("bench: a mesh's peak memory does not include what the bench held befo
   CHECK(small_peak > 0);
   CHECK(small_peak < alone_peak + 2);
   CHECK(big_peak > small_peak + 5);
+  // -q: no progress, table or summary; the JSON still written.
+  const std::string quiet_json = dir + "/quiet.json";
+  CliRun q = run_cli("bench -q " + quote(small) + " --effort 0 --threads 1 -o " + quote(quiet_json), dir);
+  REQUIRE(q.exit_code == 0);
+  CHECK(q.out.empty());
+  CHECK(q.err.empty());
+  CHECK(r.out.find("total CPU") != std::string::npos);
+  CHECK(parse_json(slurp(quiet_json))["rows"].size() == 1);
 }
 
 // bench --reference-dir runs the reference's pipeline script after ours on each mesh and

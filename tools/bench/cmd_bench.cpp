@@ -69,6 +69,7 @@ struct BenchArgs {
   std::optional<int> effort;
   std::optional<int> threads;
   std::string reference_dir, reference_script;
+  bool quiet = false;  // no progress, table or summary (errors and warnings still)
 };
 
 bool has_meshes(const fs::path& dir) {
@@ -295,9 +296,10 @@ int run_bench(const BenchArgs& a) {
     if (!k.ok()) return print_error(k.status());
     kit = k.value();
   }
-  std::printf("spherekit %s bench: %zu meshes from %s; reference: %s\n", kVersion, meshes.size(), source.c_str(),
-              kit ? ("measured in this run (" + kit->mpl_root.string() + ")").c_str()
-                  : "figures recorded in EVALUATION.md (another machine)");
+  if (!a.quiet)
+    std::printf("spherekit %s bench: %zu meshes from %s; reference: %s\n", kVersion, meshes.size(), source.c_str(),
+                kit ? ("measured in this run (" + kit->mpl_root.string() + ")").c_str()
+                    : "figures recorded in EVALUATION.md (another machine)");
 
   Table table({"mesh", "V", "F", "eff", "ref eff", "d eff", "Linf", "ref Linf", "Linf ratio", "flips", "CPU s",
                "ref CPU", "CPU ratio", "wall s", "peak MB", "ref MB", "MB ratio", "status"});
@@ -316,7 +318,7 @@ int run_bench(const BenchArgs& a) {
     std::vector<std::string> args = {"param", mesh, "-o", sphere, "--report", report_path, "--quiet"};
     if (a.effort) args.insert(args.end(), {"--effort", std::to_string(*a.effort)});
     if (a.threads) args.insert(args.end(), {"--threads", std::to_string(*a.threads)});
-    std::fprintf(stderr, "[bench] %zu/%zu %s\n", i + 1, meshes.size(), mesh.c_str());
+    if (!a.quiet) std::fprintf(stderr, "[bench] %zu/%zu %s\n", i + 1, meshes.size(), mesh.c_str());
 
     auto child = run_child(args);
     if (!child.ok()) return print_error(child.status());
@@ -436,27 +438,30 @@ int run_bench(const BenchArgs& a) {
     rows.push_back(std::move(row));
   }
 
-  std::printf("\n");
-  table.print();
   const bool any_ref = ref_cpu_total > 0;
-  std::printf("\ntotal CPU %.1f s, wall %.1f s", cpu_total, wall_total);
-  if (any_ref)
-    std::printf("; on meshes with reference figures: CPU %.1f s vs %.1f s (ratio %.2f), worst efficiency delta "
-                "%+.4f, worst memory ratio %.2f",
-                cpu_total_with_ref, ref_cpu_total, cpu_total_with_ref / ref_cpu_total, worst_eff_delta, worst_mb_ratio);
-  std::printf("\n%d failed, %d flipped faces in total\n", failed, flipped_total);
-  if (kit) {
-    std::string names;
-    for (const Json& name : reference_failed) names += (names.empty() ? "" : ", ") + name.get<std::string>();
-    std::printf("reference: %d flipped faces in its maps; failed on %zu meshes%s\n", reference_flipped_total,
-                reference_failed.size(), names.empty() ? "" : (" (" + names + ")").c_str());
-  }
-  if (linf_compared > 0) {
-    std::string over;
-    for (const Json& name : linf_over) over += (over.empty() ? "" : ", ") + name.get<std::string>();
-    std::printf("Linf rule (ours <= %.1fx the reference's): %s, %zu of %d meshes above, worst ratio %.2f%s\n",
-                kLinfRatioLimit, linf_over.empty() ? "pass" : "FAIL", linf_over.size(), linf_compared, worst_linf_ratio,
-                linf_over.empty() ? "" : ("; above on " + over).c_str());
+  if (!a.quiet) {
+    std::printf("\n");
+    table.print();
+    std::printf("\ntotal CPU %.1f s, wall %.1f s", cpu_total, wall_total);
+    if (any_ref)
+      std::printf("; on meshes with reference figures: CPU %.1f s vs %.1f s (ratio %.2f), worst efficiency delta "
+                  "%+.4f, worst memory ratio %.2f",
+                  cpu_total_with_ref, ref_cpu_total, cpu_total_with_ref / ref_cpu_total, worst_eff_delta,
+                  worst_mb_ratio);
+    std::printf("\n%d failed, %d flipped faces in total\n", failed, flipped_total);
+    if (kit) {
+      std::string names;
+      for (const Json& name : reference_failed) names += (names.empty() ? "" : ", ") + name.get<std::string>();
+      std::printf("reference: %d flipped faces in its maps; failed on %zu meshes%s\n", reference_flipped_total,
+                  reference_failed.size(), names.empty() ? "" : (" (" + names + ")").c_str());
+    }
+    if (linf_compared > 0) {
+      std::string over;
+      for (const Json& name : linf_over) over += (over.empty() ? "" : ", ") + name.get<std::string>();
+      std::printf("Linf rule (ours <= %.1fx the reference's): %s, %zu of %d meshes above, worst ratio %.2f%s\n",
+                  kLinfRatioLimit, linf_over.empty() ? "pass" : "FAIL", linf_over.size(), linf_compared,
+                  worst_linf_ratio, linf_over.empty() ? "" : ("; above on " + over).c_str());
+    }
   }
 
   if (!a.output.empty()) {
@@ -489,7 +494,7 @@ int run_bench(const BenchArgs& a) {
     }
     j["totals"] = std::move(totals);
     if (Status s = write_json_atomic(a.output, j); !s.ok()) return print_error(s);
-    std::printf("wrote %s\n", a.output.c_str());
+    if (!a.quiet) std::printf("wrote %s\n", a.output.c_str());
   }
   return worst;
 }
@@ -524,6 +529,7 @@ void register_bench(CLI::App& app) {
                   "ours and compare with what it measures here, not with recorded figures");
   cmd->add_option("--reference-script", args->reference_script,
                   "mpl_sphereparam.sh (default: shared/anchors/mpl/ beside the dev meshes)");
+  cmd->add_flag("-q,--quiet", args->quiet, "print neither progress nor the table (errors and warnings still)");
   cmd->callback([args] { set_exit_code(run_bench(*args)); });
 }
 

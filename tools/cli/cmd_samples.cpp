@@ -15,6 +15,7 @@ namespace {
 
 struct SamplesArgs {
   std::string output;
+  bool quiet = false;
   samples::SampleCollectionOptions options;
 };
 
@@ -27,6 +28,7 @@ int run_samples(const SamplesArgs& a) {
   if (!collection.ok()) return print_error(collection.status());
   if (Status s = samples::write_sample_collection(a.output, collection.value()); !s.ok()) return print_error(s);
 
+  if (a.quiet) return 0;
   for (const samples::SampleMesh& m : collection.value())
     std::printf("%s/%s.obj: %lld vertices, %lld faces, %d hole%s, %zu landmarks\n", a.output.c_str(), m.name.c_str(),
                 static_cast<long long>(m.mesh.V.rows()), static_cast<long long>(m.mesh.F.rows()), m.boundary_loops,
@@ -46,13 +48,14 @@ void register_samples(CLI::App& app) {
       "NAME.template.txt (ground-truth template point per vertex) and NAME.corr.txt (corresponding\n"
       "vertices, line k of every member is the same point). Deterministic in the options.",
       "  spherekit samples -o samples\n"
-      "  spherekit samples -o big --members 8 --vertices 20000 --seed 7");
+      "  spherekit samples -o big --members 8 --target-vertices 20000 --seed 7");
   cmd->add_option("-o,--output", args->output, "folder to write (created if missing)")->required();
   cmd->add_option("--members", args->options.members, "how many shapes")->check(CLI::Range(1, 1000))->capture_default_str();
   cmd->add_option("--target-vertices", args->options.target_vertices, "approximate vertex count per shape")
       ->check(CLI::Range(100, 10000000))->capture_default_str();
   cmd->add_option("--vertices", args->options.target_vertices)->check(CLI::Range(100, 10000000))->group("");
   cmd->add_option("--seed", args->options.seed, "seed of all shape and meshing randomness")->capture_default_str();
+  cmd->add_flag("-q,--quiet", args->quiet, "print no summary (errors still)");
   cmd->callback([args] { set_exit_code(run_samples(*args)); });
 }
 

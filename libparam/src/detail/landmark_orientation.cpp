@@ -92,7 +92,8 @@ int ambiguous_sphere_choice(const std::vector<std::pair<double, int>>& scored, i
     double first = 0, second = 0;
     for (const auto& sc : scored) {
       const int c = sc.second;
-      const double e = c >= 0 && c < static_cast<int>(efficiency.size()) ? efficiency[static_cast<std::size_t>(c)] : 0.0;
+      const bool known = c >= 0 && c < static_cast<int>(efficiency.size());
+      const double e = known ? efficiency[static_cast<std::size_t>(c)] : 0.0;
       if (e > first) {
         second = first;
         first = e;

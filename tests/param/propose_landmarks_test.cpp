@@ -578,54 +578,18 @@ TEST_CASE("sphere test fallback: the turns' pick stands unless the test ruled it
   CHECK(ambiguous_sphere_choice(edge, -1, 0.5, 0.25, 0.3) == 3);
 }
 
-TEST_CASE("shared ICT heads with decimated members: the openings are matched by the sure landmarks only",
-          "[param][shared]") {
-  // head_s1 and three heads of other people decimated to other connectivity. Two limb tips of
-  // the nose's extremity, matched within its region, landed 0.13-0.15 sqrt(area) off on one
-  // member; with them among the landmarks the openings (eyes, mouth) matched nowhere, and the
-  // heads had 6 landmarks, 79% of them within 0.05 of their true partners. The openings are
-  // now matched without region-matched peaks, which the rim points then judge.
-  SPHEREKIT_REQUIRE_SHARED_MESHES(shared);
-  const std::string fam = shared + "/families/ict_heads/";
-  const std::vector<std::string> names = {"head_s1", "head_s2_dec6500", "head_s3_dec5000", "head_s4_dec4000"};
-  std::vector<TriMesh> meshes;
-  std::vector<std::vector<int>> gt;  // per vertex: its template vertex (head_s1's numbering)
-  for (const auto& n : names) {
-    meshes.push_back(test::read_shared_mesh(fam + n + ".obj"));
-    gt.push_back(test::read_int_list(fam + n + ".gt.txt"));
-    REQUIRE(gt.back().size() == static_cast<std::size_t>(meshes.back().V.rows()));
-  }
-  ProposeLandmarksOptions o;
-  o.reference = 0;
-  auto r = propose_landmarks(meshes, o);
-  REQUIRE(r.ok());
-  INFO("landmarks " << r->names.size() << ", rim points " << r->rim_matched << ", extremities " << r->extremities);
-  CHECK(r->rim_matched >= 4);
-  // Each member's landmark, as its template point on head_s1, against the reference's.
-  const TriMesh& t = meshes[0];
-  const double area = mesh_area_for_test(t);
-  int pairs = 0, within = 0;
-  for (std::size_t i = 1; i < meshes.size(); ++i)
-    for (std::size_t k = 0; k < r->names.size(); ++k) {
-      const int a = gt[0][static_cast<std::size_t>(r->landmarks[0][k].vertex)];
-      const int b = gt[i][static_cast<std::size_t>(r->landmarks[i][k].vertex)];
-      const double err = (t.V.row(a) - t.V.row(b)).norm() / std::sqrt(area);
-      UNSCOPED_INFO(names[i] << " " << r->names[k] << " error " << err);
-      ++pairs;
-      within += err <= 0.05;
-    }
-  CHECK(within >= 0.9 * pairs);
-}
-
 namespace {
 
 // Proposed landmarks of a shared family against its ground truth, `.corr.txt` (line k of
 // every file: the same surface point) or `.gt.txt` (per vertex: its template vertex, numbered
 // as member 0's). Member 0's landmark k, carried to member i by the truth, against member i's
-// landmark k (straight distance / sqrt(area): a swapped limb is ~0.3-0.7 off). Returns
-// (within 0.05, pairs).
-std::pair<int, int> shared_family_landmarks_within(const std::string& fam, const std::vector<std::string>& names,
-                                                   const std::string& truth = "corr") {
+// landmark k (straight distance / sqrt(area): a swapped limb is ~0.3-0.7 off).
+struct FamilyLandmarks {
+  ProposeLandmarksResult result;
+  int within = 0, pairs = 0;  // pairs within 0.05, all pairs
+};
+FamilyLandmarks shared_family_landmarks(const std::string& fam, const std::vector<std::string>& names,
+                                        const std::string& truth = "corr", const ProposeLandmarksOptions& o = {}) {
   std::vector<TriMesh> meshes;
   std::vector<std::vector<int>> t;
   for (const auto& n : names) {
@@ -634,14 +598,16 @@ std::pair<int, int> shared_family_landmarks_within(const std::string& fam, const
     if (truth == "corr") REQUIRE(t.back().size() == t.front().size());
     else REQUIRE(t.back().size() == static_cast<std::size_t>(meshes.back().V.rows()));
   }
-  auto r = propose_landmarks(meshes, ProposeLandmarksOptions{});
+  auto r = propose_landmarks(meshes, o);
   REQUIRE(r.ok());
-  REQUIRE(r->names.size() >= 5);
-  int pairs = 0, within = 0;
+  FamilyLandmarks out;
+  out.result = std::move(r.value());
+  const ProposeLandmarksResult& lm = out.result;
   for (std::size_t i = 1; i < meshes.size(); ++i) {
-    double err = 0;
-    for (std::size_t k = 0; k < r->names.size(); ++k) {
-      const int a = r->landmarks[0][k].vertex, b = r->landmarks[i][k].vertex;
+    const double scale = std::sqrt(mesh_area_for_test(truth == "corr" ? meshes[i] : meshes[0]));
+    for (std::size_t k = 0; k < lm.names.size(); ++k) {
+      const int a = lm.landmarks[0][k].vertex, b = lm.landmarks[i][k].vertex;
+      double err = 0;
       if (truth == "corr") {
         const Eigen::RowVector3d p = meshes[0].V.row(a);
         std::size_t nearest = 0;
@@ -650,21 +616,39 @@ std::pair<int, int> shared_family_landmarks_within(const std::string& fam, const
           const double d = (meshes[0].V.row(t[0][l]) - p).squaredNorm();
           if (d < best) best = d, nearest = l;
         }
-        err = (meshes[i].V.row(t[i][nearest]) - meshes[i].V.row(b)).norm() / std::sqrt(mesh_area_for_test(meshes[i]));
+        err = (meshes[i].V.row(t[i][nearest]) - meshes[i].V.row(b)).norm() / scale;
       } else {  // both as template points, on member 0
         const Eigen::RowVector3d pa = meshes[0].V.row(t[0][static_cast<std::size_t>(a)]);
         const Eigen::RowVector3d pb = meshes[0].V.row(t[i][static_cast<std::size_t>(b)]);
-        err = (pa - pb).norm() / std::sqrt(mesh_area_for_test(meshes[0]));
+        err = (pa - pb).norm() / scale;
       }
-      UNSCOPED_INFO(names[i] << " " << r->names[k] << " error " << err);
-      ++pairs;
-      within += err <= 0.05;
+      UNSCOPED_INFO(names[i] << " " << lm.names[k] << " error " << err);
+      ++out.pairs;
+      out.within += err <= 0.05;
     }
   }
-  return {within, pairs};
+  return out;
 }
 
 }  // namespace
+
+TEST_CASE("shared ICT heads with decimated members: the openings are matched by the sure landmarks only",
+          "[param][shared]") {
+  // head_s1 and three heads of other people decimated to other connectivity. Two limb tips of
+  // the nose's extremity, matched within its region, landed 0.13-0.15 sqrt(area) off on one
+  // member; with them among the landmarks the openings (eyes, mouth) matched nowhere, and the
+  // heads had 6 landmarks, 79% of them within 0.05 of their true partners. The openings are
+  // now matched without region-matched peaks, which the rim points then judge.
+  SPHEREKIT_REQUIRE_SHARED_MESHES(shared);
+  ProposeLandmarksOptions o;
+  o.reference = 0;
+  const FamilyLandmarks f = shared_family_landmarks(
+      shared + "/families/ict_heads/", {"head_s1", "head_s2_dec6500", "head_s3_dec5000", "head_s4_dec4000"}, "gt", o);
+  const ProposeLandmarksResult& r = f.result;
+  INFO("landmarks " << r.names.size() << ", rim points " << r.rim_matched << ", extremities " << r.extremities);
+  CHECK(r.rim_matched >= 4);
+  CHECK(f.within >= 0.9 * f.pairs);
+}
 
 TEST_CASE("shared meshes: TOSCA cats' proposed landmarks lie on their true partners, limbs not swapped",
           "[param][shared]") {
@@ -674,26 +658,28 @@ TEST_CASE("shared meshes: TOSCA cats' proposed landmarks lie on their true partn
   // pairs within 0.05, and that member's consistent map twisted. The constrained maps'
   // efficiency settles it (the right assignment's map 1.15x as efficient as any other).
   SPHEREKIT_REQUIRE_SHARED_MESHES(shared);
-  const auto [within, pairs] =
-      shared_family_landmarks_within(shared + "/families/tosca_cat/", {"cat0", "cat2", "cat5", "cat9"});
-  CHECK(within >= 0.9 * pairs);
+  const FamilyLandmarks f = shared_family_landmarks(shared + "/families/tosca_cat/", {"cat0", "cat2", "cat5", "cat9"});
+  REQUIRE(f.result.names.size() >= 5);
+  CHECK(f.within >= 0.9 * f.pairs);
 }
 
 TEST_CASE("shared meshes: ICT heads' proposed landmarks lie on their true partners", "[param][shared]") {
   // Extremities, finer peaks and the rims of the eyes and the mouth (README: 99.3% within 0.05).
   SPHEREKIT_REQUIRE_SHARED_MESHES(shared);
-  const auto [within, pairs] = shared_family_landmarks_within(
-      shared + "/families/ict_heads/", {"head_s1", "head_s2", "head_s3", "head_s4"}, "gt");
-  CHECK(within >= 0.9 * pairs);
+  const FamilyLandmarks f =
+      shared_family_landmarks(shared + "/families/ict_heads/", {"head_s1", "head_s2", "head_s3", "head_s4"}, "gt");
+  REQUIRE(f.result.names.size() >= 5);
+  CHECK(f.within >= 0.9 * f.pairs);
 }
 
 TEST_CASE("shared meshes: FAUST bodies' proposed landmarks lie on their true partners", "[param][shared]") {
   // Hands, feet, head and the thumbs; a turned-round body (front onto back) is what the sphere
   // test rules out here, by the signal alone.
   SPHEREKIT_REQUIRE_SHARED_MESHES(shared);
-  const auto [within, pairs] = shared_family_landmarks_within(
-      shared + "/families/faust5k/", {"tr_reg_000", "tr_reg_013", "tr_reg_027", "tr_reg_041"});
-  CHECK(within >= 0.9 * pairs);
+  const FamilyLandmarks f = shared_family_landmarks(shared + "/families/faust5k/",
+                                                    {"tr_reg_000", "tr_reg_013", "tr_reg_027", "tr_reg_041"});
+  REQUIRE(f.result.names.size() >= 5);
+  CHECK(f.within >= 0.9 * f.pairs);
 }
 
 TEST_CASE("suspect_landmarks: a given file's swapped names are reported, right files pass", "[param]") {

@@ -179,6 +179,7 @@ Json refinement_json(const RefinedMember& m) {
   j["crushed_faces"] = m.crushed_faces;
   j["folded_samples_left_out"] = m.folded_samples_left_out;
   j["flow_relaxations"] = m.flow_relaxations;
+  j["snap_moves"] = m.snap_moves;
   j["efficiency_before"] = m.efficiency_before;
   j["efficiency_after"] = m.efficiency_after;
   return j;
@@ -213,6 +214,8 @@ Result<std::optional<RefinedMember>> refine_added_member(const formats::Collecti
     ro.stretch_passes = r.value("stretch_passes", 0);
     // Likewise for the growing sample counts: before them every round took `samples`.
     ro.sample_growth = r.value("sample_growth", 1);
+    // And for the snap toward the fitted partners.
+    ro.snap_sweeps = r.value("snap_sweeps", 0);
     ro.max_samples = r.value("max_samples", ro.max_samples);
     ro.vertices_per_sample = r.value("vertices_per_sample", ro.vertices_per_sample);
   }
@@ -302,6 +305,7 @@ formats::CollectionManifest manifest_of(const MakeCollectionResult& out, const C
                                      {"rounds", o.refinement.rounds},
                                      {"samples", o.refinement.samples},
                                      {"stretch_passes", o.refinement.stretch_passes},
+                                     {"snap_sweeps", o.refinement.snap_sweeps},
                                      {"sample_growth", o.refinement.sample_growth},
                                      {"max_samples", o.refinement.max_samples},
                                      {"vertices_per_sample", o.refinement.vertices_per_sample}};

@@ -182,7 +182,7 @@ void bind_param(pyb::module_& m) {
                                pyb::arg("samples") = m.samples, pyb::arg("energy_before") = m.energy_before,
                                pyb::arg("energy_after") = m.energy_after, pyb::arg("crushed_faces") = m.crushed_faces,
                                pyb::arg("folded_samples_left_out") = m.folded_samples_left_out,
-                               pyb::arg("flow_relaxations") = m.flow_relaxations,
+                               pyb::arg("flow_relaxations") = m.flow_relaxations, pyb::arg("snap_moves") = m.snap_moves,
                                pyb::arg("efficiency_before") = m.efficiency_before,
                                pyb::arg("efficiency_after") = m.efficiency_after, pyb::arg("seconds") = m.seconds));
         return out;

@@ -245,7 +245,8 @@ TEST_CASE("collection commands fail with one line and leave nothing behind", "[c
 // The refinement's later rounds flow onto more samples (256, 512, 512), at most one per 8
 // member vertices (these 900-vertex members keep 256); a collection written before that has no
 // `sample_growth` entry, and add refines a member as its members were refined: 256 samples in
-// every round, whatever the other entries say.
+// every round, whatever the other entries say (and without the snap when there is no
+// `snap_sweeps` entry).
 TEST_CASE("add refines a new member with the sample counts the collection was made with", "[cli][collection]") {
   const std::string dir = spherekit::test::temp_dir("cli_collection_growth");
   const std::string s = dir + "/samples", col = dir + "/col";
@@ -281,9 +282,14 @@ TEST_CASE("add refines a new member with the sample counts the collection was ma
     INFO(c.dump());
     REQUIRE(c["refined"] == true);
     REQUIRE(c["rounds"] == 3);
-    return c["samples"].get<int>();
+    return c;
   };
-  CHECK(readd_b([](json& o) { o["vertices_per_sample"] = 1; }) == 512);
+  CHECK(readd_b([](json& o) { o["vertices_per_sample"] = 1; })["samples"] == 512);
   // ... and in a collection written before the growing counts, 256 in every round.
-  CHECK(readd_b([](json& o) { o.erase("sample_growth"); }) == 256);
+  CHECK(readd_b([](json& o) { o.erase("sample_growth"); })["samples"] == 256);
+  // Likewise the snap toward the fitted partners before the stretch passes: on by default,
+  // and not made in a collection written before it.
+  CHECK(man["options"]["refinement"]["snap_sweeps"] == 3);
+  CHECK(man["meshes"][1]["result"]["correspondence_refinement"]["snap_moves"].get<int>() > 0);
+  CHECK(readd_b([](json& o) { o.erase("snap_sweeps"); })["snap_moves"] == 0);
 }

@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "test_meshes.h"
+#include "detail/feature_warp.h"
 #include "spherekit/consistent_param.h"
 #include "spherekit/correspondence.h"
 #include "spherekit/metrics.h"
@@ -262,6 +263,7 @@ TEST_CASE("the stretch polish after each flow raises the efficiency and keeps th
     RefineCorrespondenceOptions o;
     o.threads = 1;
     o.stretch_passes = passes;
+    o.snap_sweeps = 0;  // the passes alone (the snap alone nearly reaches this fit: see below)
     auto r = refine_correspondence(meshes, features, maps, o);
     REQUIRE(r.ok());
     *rep = r->members[1];
@@ -286,6 +288,100 @@ TEST_CASE("the stretch polish after each flow raises the efficiency and keeps th
   INFO("error before " << before << ", unpolished " << e_plain << ", polished " << e_polished);
   CHECK(e_polished < 0.35 * before);
   CHECK(e_polished < 1.25 * e_plain);
+}
+
+// The snap toward the fitted partners (detail::snap_toward_targets): every vertex that may
+// move reaches a target the others leave room for; a target across the vertex's ring is
+// approached only as far as its faces stay positive and at least half their size.
+TEST_CASE("the snap moves vertices onto their targets without a flip or a sliver", "[refine]") {
+  const TriMesh m = test::icosphere(3);
+  const RowMat3d S0 = m.V;
+  REQUIRE(count_flipped_faces(m.F, S0) == 0);
+  // Targets: the map turned by a small angle (a valid map); vertex 0 may not move.
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.05, Eigen::Vector3d(1, 2, 2).normalized()).toRotationMatrix();
+  RowMat3d T = (S0 * R.transpose()).eval();
+  for (Eigen::Index v = 0; v < T.rows(); ++v) T.row(v).normalize();
+  std::vector<char> movable(static_cast<size_t>(S0.rows()), 1);
+  movable[0] = 0;
+  RowMat3d S = S0;
+  const int moves = detail::snap_toward_targets(m.F, T, movable, 3, &S);
+  CHECK(moves >= S0.rows() - 1);
+  CHECK(S.row(0) == S0.row(0));
+  CHECK(count_flipped_faces(m.F, S) == 0);
+  int reached = 0;
+  for (Eigen::Index v = 1; v < S.rows(); ++v) reached += (S.row(v) - T.row(v)).norm() < 1e-15;
+  CHECK(reached == S.rows() - 1);
+  // One vertex sent across its ring, beyond its farthest neighbour: it moves part of the way
+  // or not at all, never through a face.
+  const int v = 5;
+  int far = -1;
+  double best = -1;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    for (int c = 0; c < 3; ++c)
+      if (m.F(f, c) == v)
+        for (int k = 1; k < 3; ++k) {
+          const int u = m.F(f, (c + k) % 3);
+          const double d = (S0.row(u) - S0.row(v)).norm();
+          if (d > best) best = d, far = u;
+        }
+  RowMat3d T2 = S0;
+  T2.row(v) = (S0.row(v) + 2.0 * (S0.row(far) - S0.row(v))).normalized();
+  std::vector<char> only(static_cast<size_t>(S0.rows()), 0);
+  only[static_cast<size_t>(v)] = 1;
+  for (int sweeps : {1, 3}) {
+    RowMat3d S2 = S0;
+    CHECK(detail::snap_toward_targets(m.F, T2, only, sweeps, &S2) <= sweeps);
+    CHECK(count_flipped_faces(m.F, S2) == 0);
+    CHECK(S2.row(v) != S0.row(v));
+    CHECK((S2.row(v) - S0.row(v)).norm() < (T2.row(v) - S0.row(v)).norm());
+    // Each move keeps every face at least half the size it had.
+    for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+      auto vol = [&](const RowMat3d& X) {
+        return Eigen::Vector3d(X.row(m.F(f, 0))).dot(Eigen::Vector3d(X.row(m.F(f, 1))).cross(Eigen::Vector3d(X.row(m.F(f, 2)))));
+      };
+      CHECK(vol(S2) >= std::pow(0.5, sweeps) * vol(S0));
+    }
+    for (Eigen::Index u = 0; u < S0.rows(); ++u)
+      if (u != v) CHECK(S2.row(u) == S0.row(u));
+  }
+}
+
+// The refinement with and without the snap before the stretch passes: the same twisted copy
+// ends nearer the template with it, as bijective and about as efficient.
+TEST_CASE("the snap before the stretch passes keeps more of the fit", "[refine]") {
+  const TwistCase c = twist_case();
+  const RowMat3d S1 = twisted(c.St, c.St.row(c.feature).transpose(), 0.5);
+  std::vector<TriMesh> meshes{c.tmpl, c.copy};
+  std::vector<std::vector<int>> features{{c.feature}, {c.feature}};
+  auto refine = [&](int sweeps, RefinedMember* rep) {
+    std::vector<RowMat3d> maps{c.St, S1};
+    RefineCorrespondenceOptions o;
+    o.threads = 1;
+    o.snap_sweeps = sweeps;
+    auto r = refine_correspondence(meshes, features, maps, o);
+    REQUIRE(r.ok());
+    *rep = r->members[1];
+    INFO(rep->note);
+    REQUIRE(rep->refined);
+    return maps[1];
+  };
+  RefinedMember without, with;
+  const RowMat3d Sw = refine(0, &without), Ss = refine(3, &with);
+  CHECK(without.snap_moves == 0);
+  CHECK(with.snap_moves > 0);
+  CHECK(count_flipped_faces(c.copy.F, Ss) == 0);
+  CHECK(Ss.row(c.feature) == c.St.row(c.feature));
+  const double e_without = copy_error(c.tmpl, c.St, c.copy, Sw), e_with = copy_error(c.tmpl, c.St, c.copy, Ss);
+  INFO("error without the snap " << e_without << ", with " << e_with << "; efficiency " << without.efficiency_after
+                                 << " -> " << with.efficiency_after);
+  CHECK(e_with < e_without);
+  CHECK(with.efficiency_after >= 0.95 * without.efficiency_after);
+  RefineCorrespondenceOptions bad;
+  bad.snap_sweeps = -1;
+  std::vector<RowMat3d> maps{c.St, S1};
+  auto r = refine_correspondence(meshes, features, maps, bad);
+  REQUIRE_FALSE(r.ok());
+  CHECK(r.status().code() == ErrorCode::InvalidArgument);
 }
 
 namespace {

@@ -71,6 +71,12 @@ struct RefineCorrespondenceOptions {
   /// stage's weights): they take out the stretch the flow leaves between its samples. 0 =
   /// none. Shape-defining.
   int stretch_passes = 3;
+  /// Sweeps moving each member vertex from the flow's map toward its fitted partner (as far
+  /// as its faces stay positive and at least half their size) before the stretch passes: the
+  /// flow carries the fit at its samples only, and the passes, converging locally, keep more
+  /// of the fit between them when they start nearer to it. 0 = none, as collections refined
+  /// before it were (their manifests have no entry). Shape-defining.
+  int snap_sweeps = 3;
   int threads = 0;  ///< members refined at once (0 = hardware). Effort only.
 };
 
@@ -94,6 +100,8 @@ struct RefinedMember {
   /// Stretch passes the flows of the rounds taken made where a flow stalled (features and
   /// samples held; the flow then went on).
   int flow_relaxations = 0;
+  /// Vertex moves toward the fitted partners (snap_sweeps) in the rounds taken.
+  int snap_moves = 0;
   /// Stretch efficiency of the member's map before and after (metrics.h). A round that
   /// would leave less than 0.8x the lower of the member's starting efficiency and the
   /// template's is not taken (agreeing maps carry the template's distortion).

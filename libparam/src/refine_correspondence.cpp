@@ -547,10 +547,11 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
     return Status(ErrorCode::InvalidArgument, "need one feature list and one map per mesh");
   const int t = options.template_mesh;
   if (t < 0 || t >= n) return Status(ErrorCode::InvalidArgument, "template " + std::to_string(t) + " is not a mesh index");
-  if (options.iterations < 0 || !(options.damping > 0) || options.stretch_passes < 0 || options.snap_sweeps < 0 || options.sample_growth < 1 ||
-      options.vertices_per_sample < 1)
+  if (options.iterations < 0 || !(options.damping > 0) || options.stretch_passes < 0 || options.snap_sweeps < 0 ||
+      options.sample_growth < 1 || options.vertices_per_sample < 1)
     return Status(ErrorCode::InvalidArgument,
-                  "iterations, stretch passes and snap sweeps must be >= 0, damping > 0, the sample growth and vertices per sample >= 1");
+                  "iterations, stretch passes and snap sweeps must be >= 0, damping > 0, the sample growth and vertices "
+                  "per sample >= 1");
   for (int i = 0; i < n; ++i) {
     if (maps[static_cast<size_t>(i)].rows() != meshes[static_cast<size_t>(i)].V.rows())
       return Status(ErrorCode::InvalidArgument, "mesh " + std::to_string(i) + ": map and mesh sizes differ");

@@ -119,10 +119,9 @@ int leave_out_folded_samples(const RowMat3i& F, const RowMat3d& Sc, const std::v
 /// vertex v with movable[v] != 0 moves from S's point toward T's along the chord (projected),
 /// the whole way or 1/2, 1/4, 1/8 of it, the first that keeps every face around v positive
 /// (exact predicate) and at least half as large as it was (signed volume with the origin: no
-/// move makes a sliver the stretch passes then cannot undo; a face may so shrink to 1/2^sweeps),
-/// else it stays; `sweeps` passes in
-/// vertex order (deterministic). Returns the moves made. Keeps S bijective (each move stays in
-/// the kernel of v's ring).
+/// move makes a sliver the stretch passes then cannot undo; over `sweeps` sweeps a face may
+/// shrink to 1/2^sweeps), else it stays. Sweeps go in vertex order (deterministic). Returns the
+/// moves made. Keeps S bijective (each move stays in the kernel of v's ring).
 int snap_toward_targets(const RowMat3i& F, const RowMat3d& T, const std::vector<char>& movable, int sweeps,
                         RowMat3d* S);
 

@@ -268,6 +268,7 @@ Status refine_maps(const std::vector<TriMesh>& meshes, const std::vector<std::ve
   RefineCorrespondenceOptions ro = options.refinement;
   ro.template_mesh = options.reference;
   ro.threads = options.threads;
+  ro.own_efficiency = result->unconstrained_efficiency;  // 0 where not measured (no efficiency retry)
   std::vector<RowMat3d> S(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) S[static_cast<size_t>(i)] = result->maps[static_cast<size_t>(i)].map.S;
   SPHEREKIT_ASSIGN_OR_RETURN(result->refinement, refine_correspondence(meshes, features, S, ro, progress));

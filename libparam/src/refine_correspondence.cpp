@@ -584,7 +584,13 @@ Result<RefineCorrespondenceResult> refine_correspondence(const std::vector<TriMe
         RowMat3d cur = maps[static_cast<size_t>(i)];
         SPHEREKIT_ASSIGN_OR_RETURN(const SphereMapMetrics m0, evaluate_sphere_map(mi, cur));
         rep.efficiency_before = rep.efficiency_after = m0.efficiency;
-        const double bar = std::min(m0.efficiency, template_efficiency);
+        // The member's own unconstrained efficiency where known: measured from the step-6 map,
+        // a member already at 0.81x its own lost another 0.8x (a generated creature's member
+        // ended at 0.70x its own unconstrained efficiency, session 50).
+        const double own = std::ssize(options.own_efficiency) > i && options.own_efficiency[static_cast<size_t>(i)] > 0
+                               ? options.own_efficiency[static_cast<size_t>(i)]
+                               : m0.efficiency;
+        const double bar = std::min(own, template_efficiency);
         const VertexFaces mi_faces(mi);
         const Result<FilledMesh> mi_closed = fill_holes(mi);  // the polish's and the flow's relaxation's
         // Each round after the first flows onto sample_growth times as many samples as the

@@ -192,7 +192,8 @@ Json refinement_json(const RefinedMember& m) {
 // without it, or has no reference member (other than the one being replaced).
 Result<std::optional<RefinedMember>> refine_added_member(const formats::Collection& c, int replacing, const TriMesh& mesh,
                                                          const std::vector<int>& fv, const std::vector<Eigen::Vector3d>& F,
-                                                         const ProgressFn& progress, ConstrainedParamResult* map) {
+                                                         const ProgressFn& progress, double own_efficiency,
+                                                         ConstrainedParamResult* map) {
   const Json& opt = c.manifest.options;
   if (!opt.is_object() || !opt.value("refine_correspondence", false) || !c.manifest.reference)
     return std::optional<RefinedMember>{};
@@ -221,6 +222,7 @@ Result<std::optional<RefinedMember>> refine_added_member(const formats::Collecti
   }
   ro.template_mesh = 0;
   ro.threads = 1;
+  ro.own_efficiency = {0.0, own_efficiency};
   std::vector<TriMesh> meshes{std::move(rm.mesh), mesh};
   std::vector<std::vector<int>> features{rf, fv};
   std::vector<RowMat3d> maps{std::move(rm.map.S), map->map.S};
@@ -497,7 +499,7 @@ Result<AddToCollectionResult> add_to_collection(const AddToCollectionJob& a, con
     SPHEREKIT_RETURN_IF_ERROR(require_exact(out.map, a.mesh));
     std::optional<RefinedMember> refined;
     if (a.refine_correspondence) {
-      SPHEREKIT_ASSIGN_OR_RETURN(refined, refine_added_member(c, existing, mesh, fv, F, progress, &out.map));
+      SPHEREKIT_ASSIGN_OR_RETURN(refined, refine_added_member(c, existing, mesh, fv, F, progress, unconstrained, &out.map));
     }
     // The entry once, of the map as kept (refined or not), in the order consistent writes it.
     e.result = map_entry_json(out.map);

@@ -77,6 +77,10 @@ struct RefineCorrespondenceOptions {
   /// of the fit between them when they start nearer to it. 0 = none, as collections refined
   /// before it were (their manifests have no entry). Shape-defining.
   int snap_sweeps = 3;
+  /// Per mesh, the stretch efficiency of its own unconstrained map, where known (0 or no
+  /// entry: unknown). A round is taken only if it leaves at least 0.8x the lower of this
+  /// (else the member's starting efficiency) and the template's.
+  std::vector<double> own_efficiency;
   int threads = 0;  ///< members refined at once (0 = hardware). Effort only.
 };
 
@@ -103,8 +107,9 @@ struct RefinedMember {
   /// Vertex moves toward the fitted partners (snap_sweeps) in the rounds taken.
   int snap_moves = 0;
   /// Stretch efficiency of the member's map before and after (metrics.h). A round that
-  /// would leave less than 0.8x the lower of the member's starting efficiency and the
-  /// template's is not taken (agreeing maps carry the template's distortion).
+  /// would leave less than 0.8x the lower of the member's own unconstrained efficiency (its
+  /// starting efficiency where that is not known) and the template's is not taken (agreeing
+  /// maps carry the template's distortion).
   double efficiency_before = 0, efficiency_after = 0;
   double seconds = 0;
 };
